@@ -1,0 +1,15 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+# Every third-party dependency, found from Debian's packages (see the README for the package list).
+find_package(PkgConfig REQUIRED)
+find_package(Threads REQUIRED)
+find_package(LibVNCServer CONFIG REQUIRED)          # LibVNCServer::vncserver, LibVNCServer::vncclient
+find_package(OpenGL REQUIRED COMPONENTS EGL OpenGL)  # OpenGL::EGL, OpenGL::OpenGL (GLVND)
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)          # Eigen3::Eigen
+if(RFBSIM_BUILD_TESTS OR RFBSIM_BUILD_BENCH)
+  find_package(websocketpp CONFIG REQUIRED)          # websocketpp::websocketpp (header-only)
+  find_package(Boost REQUIRED COMPONENTS system)     # websocketpp's asio transport
+endif()
+if(RFBSIM_BUILD_TESTS)
+  find_package(Catch2 2 REQUIRED)
+  include(Catch)
+endif()

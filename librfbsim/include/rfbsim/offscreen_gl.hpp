@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// rfbsim::OffscreenGL: an OpenGL context without a window (EGL) rendering into a framebuffer object.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rfbsim/frame.hpp"
+
+namespace rfbsim {
+
+/// Definition of an off-screen context.
+struct OffscreenGLOptions {
+  int width = 1280;   ///< FBO width in pixels (> 0)
+  int height = 720;   ///< FBO height in pixels (> 0)
+  int samples = 4;    ///< MSAA samples; 0 or 1 = none (resolved before read-back)
+  /// Which EGL platform to use: "auto" tries the device platform (GPUs, e.g. NVIDIA) and then Mesa's
+  /// surfaceless platform (llvmpipe on machines without a GPU); or "device" / "surfaceless".
+  std::string platform = "auto";
+};
+
+/// An OpenGL 3.3 core context, current on the creating thread, drawing into an FBO.
+/// Owns the context and the FBO; shares one EGL display per process with every other instance.
+/// Use from the thread that created it.
+class OffscreenGL {
+ public:
+  /// Creates the display (once per process), context and FBO and makes the context current.
+  /// Throws std::runtime_error naming the failing step (no EGL display, no config, no context).
+  explicit OffscreenGL(OffscreenGLOptions options = {});
+  ~OffscreenGL();
+  OffscreenGL(const OffscreenGL&) = delete;
+  OffscreenGL& operator=(const OffscreenGL&) = delete;
+
+  /// Makes the context current on this thread and binds the FBO for drawing.
+  void begin_frame();
+  /// Resolves multisampling and reads the FBO into a reusable buffer, top row first.
+  /// The view stays valid until the next read_frame() or the destructor.
+  FrameView read_frame();
+
+  [[nodiscard]] int width() const;
+  [[nodiscard]] int height() const;
+  /// GL_RENDERER and the EGL platform in use, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) via surfaceless".
+  [[nodiscard]] std::string renderer() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rfbsim

@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// rfbsim::Server: serves submitted frames to RFB and WebSocket (noVNC) clients on one port and
+// collects their keys and pointer.
+//
+// Contract with the host program (the simulator):
+//   - The host owns its pixels; submit() copies the frame, so the view may be reused right after.
+//   - submit() and poll_input() may be called from any one thread (the simulation thread); they never
+//     wait for the network: a slow or stalled client costs frames, never simulation time.
+//   - The server owns one network thread, started by the constructor and joined by the destructor.
+//     Callbacks in ServerOptions and the handlers of json routes run on that thread: keep them short
+//     and thread-safe.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rfbsim/frame.hpp"
+#include "rfbsim/input.hpp"
+
+namespace rfbsim {
+
+/// JPEG chroma subsampling for Tight encoding.
+enum class Subsampling : std::uint8_t { k444, k422, k420, kGray };
+
+/// A client as the connect and disconnect callbacks see it.
+struct ClientInfo {
+  int id = 0;               ///< unique per server, counting from 1
+  std::string address;      ///< peer address, e.g. "127.0.0.1"
+  bool websocket = false;   ///< true when the client came in through WebSocket (a browser)
+};
+
+/// Counters since the server started. Encode time covers encoding and writing updates.
+struct ServerStats {
+  std::uint64_t frames_submitted = 0;  ///< submit() calls
+  std::uint64_t frames_applied = 0;    ///< frames copied into the framebuffer (latest wins)
+  std::uint64_t tiles_changed = 0;     ///< tiles copied into the framebuffer
+  std::uint64_t updates_sent = 0;      ///< framebuffer updates sent, summed over clients
+  std::uint64_t bytes_sent = 0;        ///< bytes written by those updates (RFB level)
+  double encode_ms = 0.0;              ///< milliseconds spent encoding and sending updates
+  std::uint64_t http_requests = 0;     ///< plain HTTP requests answered (page, files, json)
+  int clients = 0;                     ///< RFB clients connected now
+};
+
+/// Definition of a server; start from the defaults and change what you need.
+struct ServerOptions {
+  int port = 0;                              ///< TCP port; 0 picks a free one (see Server::port())
+  std::string bind_address = "127.0.0.1";    ///< IPv4 address to listen on; loopback unless told otherwise
+  int width = 1280;                          ///< framebuffer width in pixels (16..8192)
+  int height = 720;                          ///< framebuffer height in pixels (16..8192)
+  int jpeg_quality = 80;                     ///< 1..100, imposed on Tight clients; 0 = respect the client's level
+  Subsampling subsampling = Subsampling::k420;  ///< imposed together with jpeg_quality
+  int max_clients = 4;                       ///< further RFB clients are refused
+  bool view_only = false;                    ///< ignore every key and pointer event
+  std::string desktop_name = "rfbsim";       ///< the name RFB clients show
+  std::string web_root;                      ///< directory served to plain HTTP GETs; empty = none
+  std::chrono::milliseconds write_timeout{5000};  ///< a client that accepts no bytes this long is dropped
+  std::function<void(const ClientInfo&)> on_connect;     ///< network thread; may be empty
+  std::function<void(const ClientInfo&)> on_disconnect;  ///< network thread; may be empty
+  /// Extra JSON endpoints on the same port, e.g. {"/status.json", fn}; fn runs on an HTTP worker thread
+  /// and returns the body. Paths must start with '/'.
+  std::map<std::string, std::function<std::string()>> json_routes;
+};
+
+/// Serves frames over RFB (raw TCP) and RFB-over-WebSocket on one port, plus an optional static web root.
+class Server {
+ public:
+  /// Binds, listens and starts the network thread. Throws std::runtime_error naming the cause
+  /// (bad size, address not valid, port in use, web root missing).
+  explicit Server(ServerOptions options);
+  /// Stops the network thread, closes every connection and releases held keys.
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  /// The port actually bound (useful with port 0).
+  [[nodiscard]] int port() const;
+  /// The URL that opens the web page (or the RFB endpoint when there is no web root).
+  [[nodiscard]] std::string url() const;
+  /// Copies one frame (must be the server's size) into the latest-wins mailbox; never blocks on the
+  /// network. Throws std::invalid_argument on a size mismatch.
+  void submit(const FrameView& frame);
+  /// Removes and returns every input event since the last call, in arrival order.
+  std::vector<InputEvent> poll_input();
+  /// RFB clients connected now.
+  [[nodiscard]] int client_count() const;
+  /// A snapshot of the counters.
+  [[nodiscard]] ServerStats stats() const;
+  /// The options the server runs with.
+  [[nodiscard]] const ServerOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rfbsim

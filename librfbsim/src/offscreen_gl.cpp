@@ -1,0 +1,239 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// rfbsim::OffscreenGL: EGL without a window system, an OpenGL 3.3 core context and an FBO.
+#include "rfbsim/offscreen_gl.hpp"
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <cstdio>
+#include <cstring>
+#include <mutex>
+#include <stdexcept>
+#include <vector>
+
+namespace rfbsim {
+
+namespace {
+
+// The process-wide EGL display. EGL displays are shared per process: terminating one would pull it from
+// under every other context, so it is opened once and never terminated.
+struct SharedDisplay {
+  EGLDisplay display = EGL_NO_DISPLAY;
+  std::string platform;
+};
+
+std::string egl_error_text() {
+  char text[32];
+  std::snprintf(text, sizeof text, "EGL error 0x%04x", static_cast<unsigned>(eglGetError()));
+  return text;
+}
+
+EGLDisplay try_device_platform(PFNEGLGETPLATFORMDISPLAYEXTPROC get_platform_display) {
+  auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+  if (query_devices == nullptr) return EGL_NO_DISPLAY;
+  EGLDeviceEXT devices[16];
+  EGLint count = 0;
+  if (query_devices(16, devices, &count) != EGL_TRUE) return EGL_NO_DISPLAY;
+  // The first device that initialises wins: a GPU where there is one, else Mesa's software device.
+  for (EGLint i = 0; i < count; ++i) {
+    EGLDisplay display = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
+    if (display != EGL_NO_DISPLAY && eglInitialize(display, nullptr, nullptr) == EGL_TRUE) return display;
+  }
+  return EGL_NO_DISPLAY;
+}
+
+SharedDisplay open_display(const std::string& platform) {
+  auto get_platform_display =
+      reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+  if (get_platform_display == nullptr) {
+    throw std::runtime_error("no EGL display: eglGetPlatformDisplayEXT is missing (is libEGL from GLVND installed?)");
+  }
+  SharedDisplay shared;
+  if (platform == "auto" || platform == "device") {
+    shared.display = try_device_platform(get_platform_display);
+    shared.platform = "device";
+  }
+  if (shared.display == EGL_NO_DISPLAY && (platform == "auto" || platform == "surfaceless")) {
+    EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    if (display != EGL_NO_DISPLAY && eglInitialize(display, nullptr, nullptr) == EGL_TRUE) {
+      shared.display = display;
+      shared.platform = "surfaceless";
+    }
+  }
+  if (shared.display == EGL_NO_DISPLAY) {
+    throw std::runtime_error("no EGL display for platform '" + platform +
+                             "' (tried the device and Mesa surfaceless platforms; " + egl_error_text() + ")");
+  }
+  return shared;
+}
+
+const SharedDisplay& shared_display(const std::string& platform) {
+  static std::mutex mutex;
+  static SharedDisplay shared;
+  std::lock_guard lock(mutex);
+  if (shared.display == EGL_NO_DISPLAY) shared = open_display(platform);
+  return shared;
+}
+
+void check_gl(const char* step) {
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR) {
+    char text[96];
+    std::snprintf(text, sizeof text, "OpenGL error 0x%04x during %s", error, step);
+    throw std::runtime_error(text);
+  }
+}
+
+}  // namespace
+
+struct OffscreenGL::Impl {
+  OffscreenGLOptions options;
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLContext context = EGL_NO_CONTEXT;
+  EGLSurface pbuffer = EGL_NO_SURFACE;  // only where surfaceless contexts are not supported
+  std::string platform;
+  GLuint draw_fbo = 0;                   // multisampled when samples > 1
+  GLuint resolve_fbo = 0;                // single-sampled copy read back to the CPU
+  GLuint renderbuffers[3] = {0, 0, 0};   // draw colour, draw depth, resolve colour
+  std::vector<std::uint8_t> bottom_up;   // glReadPixels output
+  std::vector<std::uint8_t> top_down;    // what read_frame() hands out
+
+  void make_current() const {
+    if (eglMakeCurrent(display, pbuffer, pbuffer, context) != EGL_TRUE) {
+      throw std::runtime_error("eglMakeCurrent failed: " + egl_error_text());
+    }
+  }
+  void create_context();
+  void create_framebuffers();
+};
+
+void OffscreenGL::Impl::create_context() {
+  const SharedDisplay& shared = shared_display(options.platform);
+  display = shared.display;
+  platform = shared.platform;
+  if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) throw std::runtime_error("EGL has no desktop OpenGL API");
+
+  const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
+                                      EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_ALPHA_SIZE, 8,
+                                      EGL_DEPTH_SIZE, 24, EGL_NONE};
+  EGLConfig config = nullptr;
+  EGLint found = 0;
+  if (eglChooseConfig(display, config_attributes, &config, 1, &found) != EGL_TRUE || found < 1) {
+    throw std::runtime_error("no EGL config with RGBA8, depth 24 and desktop OpenGL: " + egl_error_text());
+  }
+  const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                       EGL_NONE};
+  context = eglCreateContext(display, config, EGL_NO_CONTEXT, context_attributes);
+  if (context == EGL_NO_CONTEXT) throw std::runtime_error("cannot create an OpenGL 3.3 core context: " + egl_error_text());
+
+  const char* extensions = eglQueryString(display, EGL_EXTENSIONS);
+  const bool surfaceless = extensions != nullptr && std::strstr(extensions, "EGL_KHR_surfaceless_context") != nullptr;
+  if (!surfaceless) {
+    const EGLint pbuffer_attributes[] = {EGL_WIDTH, 1, EGL_HEIGHT, 1, EGL_NONE};
+    pbuffer = eglCreatePbufferSurface(display, config, pbuffer_attributes);
+    if (pbuffer == EGL_NO_SURFACE) throw std::runtime_error("cannot create a pbuffer: " + egl_error_text());
+  }
+  make_current();
+}
+
+void OffscreenGL::Impl::create_framebuffers() {
+  const int w = options.width;
+  const int h = options.height;
+  const int samples = options.samples > 1 ? options.samples : 0;
+  glGenRenderbuffers(3, renderbuffers);
+  glGenFramebuffers(1, &draw_fbo);
+  glGenFramebuffers(1, &resolve_fbo);
+
+  glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers[0]);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
+  glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers[1]);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, draw_fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, renderbuffers[0]);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, renderbuffers[1]);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw std::runtime_error("the drawing framebuffer is incomplete");
+  }
+  glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers[2]);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, renderbuffers[2]);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw std::runtime_error("the read-back framebuffer is incomplete");
+  }
+  check_gl("framebuffer creation");
+  const auto bytes = static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4U;
+  bottom_up.resize(bytes);
+  top_down.resize(bytes);
+}
+
+OffscreenGL::OffscreenGL(OffscreenGLOptions options) : impl_(std::make_unique<Impl>()) {
+  if (options.width <= 0 || options.height <= 0 || options.width > 16384 || options.height > 16384) {
+    throw std::runtime_error("bad off-screen size " + std::to_string(options.width) + "x" +
+                             std::to_string(options.height));
+  }
+  impl_->options = std::move(options);
+  try {
+    impl_->create_context();
+    impl_->create_framebuffers();
+  } catch (...) {
+    if (impl_->context != EGL_NO_CONTEXT) {
+      eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+      eglDestroyContext(impl_->display, impl_->context);
+    }
+    if (impl_->pbuffer != EGL_NO_SURFACE) eglDestroySurface(impl_->display, impl_->pbuffer);
+    throw;
+  }
+  begin_frame();
+}
+
+OffscreenGL::~OffscreenGL() {
+  impl_->make_current();
+  glDeleteFramebuffers(1, &impl_->draw_fbo);
+  glDeleteFramebuffers(1, &impl_->resolve_fbo);
+  glDeleteRenderbuffers(3, impl_->renderbuffers);
+  eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  eglDestroyContext(impl_->display, impl_->context);
+  if (impl_->pbuffer != EGL_NO_SURFACE) eglDestroySurface(impl_->display, impl_->pbuffer);
+  eglReleaseThread();
+}
+
+void OffscreenGL::begin_frame() {
+  impl_->make_current();
+  glBindFramebuffer(GL_FRAMEBUFFER, impl_->draw_fbo);
+  glViewport(0, 0, impl_->options.width, impl_->options.height);
+}
+
+FrameView OffscreenGL::read_frame() {
+  const int w = impl_->options.width;
+  const int h = impl_->options.height;
+  // Resolve (or copy) into the single-sampled FBO, then read it back.
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->draw_fbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, impl_->resolve_fbo);
+  glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->resolve_fbo);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, impl_->bottom_up.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, impl_->draw_fbo);
+  // GL's first row is the bottom one; hand out the top row first.
+  const auto row_bytes = static_cast<std::size_t>(w) * 4U;
+  for (int y = 0; y < h; ++y) {
+    std::memcpy(impl_->top_down.data() + static_cast<std::size_t>(y) * row_bytes,
+                impl_->bottom_up.data() + static_cast<std::size_t>(h - 1 - y) * row_bytes, row_bytes);
+  }
+  return FrameView{impl_->top_down.data(), w, h, row_bytes};
+}
+
+int OffscreenGL::width() const { return impl_->options.width; }
+int OffscreenGL::height() const { return impl_->options.height; }
+
+std::string OffscreenGL::renderer() const {
+  const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  return std::string(name != nullptr ? name : "unknown") + " via " + impl_->platform;
+}
+
+}  // namespace rfbsim

@@ -1,0 +1,478 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// rfbsim::Server: libvncserver driven from one network thread that owns the framebuffer.
+//
+// Why one thread: libvncserver's threaded mode encodes from per-client threads that read the framebuffer
+// while the host writes it. Here a single thread alternates between copying the newest frame's changed
+// tiles into the framebuffer and letting libvncserver read input and encode updates, so nothing is ever
+// encoded while it is being written (no tearing), and the simulation thread only ever touches the mailbox.
+#include "rfbsim/server.hpp"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <rfb/rfb.h>
+#include <sys/eventfd.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+#include <thread>
+
+#include "frame_mailbox.hpp"
+#include "held_keys.hpp"
+#include "http_request.hpp"
+#include "http_service.hpp"
+#include "listener.hpp"
+#include "rfbsim/tile_damage.hpp"
+
+namespace rfbsim {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// How long a silent new connection may take to show whether it speaks HTTP. Raw RFB clients wait for the
+// server to speak first, so they are only recognised by this timeout; browsers send their request at once.
+constexpr auto kSniffTimeout = std::chrono::milliseconds(500);
+// Poll timeout when nothing is pending; only bounds how fast the thread notices a stop request.
+constexpr int kIdlePollMs = 200;
+
+// libvncserver's log goes through these global hooks; keep its chatter off unless asked for.
+bool vnc_log_enabled() {
+  static const bool enabled = std::getenv("RFBSIM_VNC_LOG") != nullptr;
+  return enabled;
+}
+void vnc_log(const char* format, ...) {
+  if (!vnc_log_enabled()) return;
+  std::fputs("[rfbsim.vnc] ", stderr);
+  va_list args;
+  va_start(args, format);
+  std::vfprintf(stderr, format, args);
+  va_end(args);
+}
+void vnc_error(const char* format, ...) {
+  std::fputs("[rfbsim.vnc] ", stderr);
+  va_list args;
+  va_start(args, format);
+  std::vfprintf(stderr, format, args);
+  va_end(args);
+}
+
+// libvncserver's index of Tight subsampling levels: 0 = 4:4:4, 1 = 4:2:0, 2 = 4:2:2, 3 = grey.
+int turbo_subsampling_index(Subsampling s) {
+  switch (s) {
+    case Subsampling::k444: return 0;
+    case Subsampling::k420: return 1;
+    case Subsampling::k422: return 2;
+    case Subsampling::kGray: return 3;
+  }
+  return 1;
+}
+
+std::string peer_address(int fd) {
+  sockaddr_storage peer{};
+  socklen_t length = sizeof peer;
+  if (::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &length) != 0) return "?";
+  char text[INET6_ADDRSTRLEN] = {};
+  if (peer.ss_family == AF_INET6) {
+    ::inet_ntop(AF_INET6, &reinterpret_cast<sockaddr_in6*>(&peer)->sin6_addr, text, sizeof text);
+  } else {
+    ::inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(&peer)->sin_addr, text, sizeof text);
+  }
+  return text;
+}
+
+ServerOptions validated(ServerOptions o) {
+  if (o.width < 16 || o.height < 16 || o.width > 8192 || o.height > 8192) {
+    throw std::runtime_error("bad frame size " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                             " (each side must be 16..8192)");
+  }
+  if (o.jpeg_quality < 0 || o.jpeg_quality > 100) throw std::runtime_error("jpeg_quality must be 0..100");
+  if (o.max_clients < 1) throw std::runtime_error("max_clients must be at least 1");
+  if (!o.web_root.empty() && !std::filesystem::is_regular_file(std::filesystem::path(o.web_root) / "index.html")) {
+    throw std::runtime_error("web root '" + o.web_root + "' has no index.html");
+  }
+  for (const auto& route : o.json_routes) {
+    if (route.first.empty() || route.first.front() != '/') {
+      throw std::runtime_error("json route '" + route.first + "' must start with '/'");
+    }
+  }
+  return o;
+}
+
+}  // namespace
+
+// Per-client bookkeeping, owned through rfbClientRec::clientData.
+struct ClientState {
+  ClientInfo info;
+  Clock::time_point update_started{};
+  int bytes_before_update = 0;
+};
+
+// A connection accepted but not yet known to be HTTP, WebSocket or raw RFB.
+struct PendingConnection {
+  int fd = -1;
+  Clock::time_point accepted{};
+};
+
+struct Server::Impl {
+  explicit Impl(ServerOptions o);
+  ~Impl();
+
+  void run();
+  void accept_new();
+  void classify_pending();
+  void adopt_rfb(int fd);
+  void apply_newest_frame();
+  int poll_timeout_ms() const;
+
+  // libvncserver hooks (C function pointers); `self` comes from screen->screenData.
+  static Impl& of(rfbClientPtr cl) { return *static_cast<Impl*>(cl->screen->screenData); }
+  static rfbNewClientAction on_new_client(rfbClientPtr cl);
+  static void on_client_gone(rfbClientPtr cl);
+  static void on_key(rfbBool down, rfbKeySym keysym, rfbClientPtr cl);
+  static void on_pointer(int mask, int x, int y, rfbClientPtr cl);
+  static void on_update_start(rfbClientPtr cl);
+  static void on_update_done(rfbClientPtr cl, int result);
+
+  ServerOptions options;
+  detail::Listener listener;
+  int wake_fd = -1;
+  rfbScreenInfoPtr screen = nullptr;
+  std::vector<std::uint8_t> framebuffer;  // what clients see; written only by the network thread
+  std::vector<std::uint8_t> incoming;     // the frame taken from the mailbox
+  detail::FrameMailbox mailbox;
+  TileDamage damage;
+  InputQueue input;
+  detail::HeldKeys held_keys;             // network thread only
+  std::vector<PendingConnection> pending; // network thread only
+  std::unique_ptr<detail::HttpService> http;
+  int next_client_id = 1;
+
+  std::atomic<bool> stopping{false};
+  std::atomic<int> clients{0};
+  std::atomic<std::uint64_t> frames_submitted{0};
+  std::atomic<std::uint64_t> frames_applied{0};
+  std::atomic<std::uint64_t> tiles_changed{0};
+  std::atomic<std::uint64_t> updates_sent{0};
+  std::atomic<std::uint64_t> bytes_sent{0};
+  std::atomic<std::uint64_t> encode_ns{0};
+  std::thread thread;
+};
+
+Server::Impl::Impl(ServerOptions o)
+    : options(validated(std::move(o))),
+      mailbox(options.width, options.height),
+      damage(options.width, options.height) {
+  rfbLog = vnc_log;
+  rfbErr = vnc_error;
+
+  listener = detail::open_listener(options.bind_address, options.port);
+  wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (wake_fd < 0) {
+    ::close(listener.fd);
+    throw std::runtime_error("cannot create an eventfd");
+  }
+
+  // The framebuffer starts a neutral dark grey until the first frame arrives.
+  framebuffer.assign(static_cast<std::size_t>(options.width) * static_cast<std::size_t>(options.height) * 4U, 0);
+  for (std::size_t i = 0; i < framebuffer.size(); i += 4) {
+    framebuffer[i] = framebuffer[i + 1] = framebuffer[i + 2] = 40;
+    framebuffer[i + 3] = 255;
+  }
+
+  int argc = 1;
+  char program[] = "rfbsim";
+  char* argv[] = {program, nullptr};
+  screen = rfbGetScreen(&argc, argv, options.width, options.height, 8, 3, 4);
+  if (screen == nullptr) {
+    ::close(listener.fd);
+    ::close(wake_fd);
+    throw std::runtime_error("libvncserver could not create a screen");
+  }
+  // Our frames are RGBA bytes: red in the lowest byte of each little-endian 32-bit pixel.
+  screen->serverFormat.redShift = 0;
+  screen->serverFormat.greenShift = 8;
+  screen->serverFormat.blueShift = 16;
+  screen->frameBuffer = reinterpret_cast<char*>(framebuffer.data());
+  screen->desktopName = options.desktop_name.c_str();
+  screen->screenData = this;
+  // We own the listening socket (to serve HTTP on the same port); libvncserver listens on nothing.
+  screen->autoPort = FALSE;
+  screen->port = 0;
+  screen->ipv6port = 0;
+  screen->httpPort = 0;
+  screen->httpDir = nullptr;
+  screen->alwaysShared = TRUE;  // several viewers of one session (participant + researcher) coexist
+  screen->deferUpdateTime = 0;  // frames already arrive in whole batches
+  screen->maxClientWait = static_cast<int>(options.write_timeout.count());
+  screen->newClientHook = on_new_client;
+  screen->kbdAddEvent = on_key;
+  screen->ptrAddEvent = on_pointer;
+  screen->displayHook = on_update_start;
+  screen->displayFinishedHook = on_update_done;
+  screen->cursor = nullptr;  // the participant's own pointer is enough; no cursor pseudo-encoding
+  rfbInitServer(screen);
+
+  detail::HttpServiceConfig http_config;
+  http_config.web_root = options.web_root;
+  http_config.json_routes = options.json_routes;
+  http = std::make_unique<detail::HttpService>(std::move(http_config));
+
+  thread = std::thread([this] { run(); });
+}
+
+Server::Impl::~Impl() {
+  stopping = true;
+  const std::uint64_t one = 1;
+  [[maybe_unused]] auto n = ::write(wake_fd, &one, sizeof one);
+  if (thread.joinable()) thread.join();
+  // The network thread is gone: closing the clients here runs on_client_gone on this thread.
+  rfbShutdownServer(screen, TRUE);
+  rfbScreenCleanup(screen);
+  for (const auto& connection : pending) ::close(connection.fd);
+  http.reset();
+  ::close(listener.fd);
+  ::close(wake_fd);
+}
+
+int Server::Impl::poll_timeout_ms() const {
+  if (pending.empty()) return kIdlePollMs;
+  auto earliest = pending.front().accepted;
+  for (const auto& connection : pending) earliest = std::min(earliest, connection.accepted);
+  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(earliest + kSniffTimeout - Clock::now());
+  return static_cast<int>(std::max<std::int64_t>(1, left.count() + 1));
+}
+
+void Server::Impl::run() {
+  std::vector<pollfd> fds;
+  while (!stopping) {
+    // Wait for a new connection, a new frame, a pending connection's first bytes or a client message.
+    fds.clear();
+    fds.push_back({listener.fd, POLLIN, 0});
+    fds.push_back({wake_fd, POLLIN, 0});
+    for (const auto& connection : pending) fds.push_back({connection.fd, POLLIN, 0});
+    rfbClientIteratorPtr it = rfbGetClientIterator(screen);
+    for (rfbClientPtr cl = rfbClientIteratorNext(it); cl != nullptr; cl = rfbClientIteratorNext(it)) {
+      if (cl->sock != RFB_INVALID_SOCKET) fds.push_back({cl->sock, POLLIN, 0});
+    }
+    rfbReleaseClientIterator(it);
+    ::poll(fds.data(), fds.size(), poll_timeout_ms());
+    if (stopping) break;
+
+    std::uint64_t wakes = 0;
+    [[maybe_unused]] auto n = ::read(wake_fd, &wakes, sizeof wakes);
+    accept_new();
+    classify_pending();
+    apply_newest_frame();
+    // Reads client messages (input, update requests) and sends pending updates; never blocks on reads.
+    rfbProcessEvents(screen, 0);
+  }
+}
+
+void Server::Impl::accept_new() {
+  for (;;) {
+    const int fd = ::accept4(listener.fd, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
+    if (fd < 0) return;  // EAGAIN: no more; other errors (EMFILE...) are retried on the next wake
+    pending.push_back({fd, Clock::now()});
+  }
+}
+
+void Server::Impl::classify_pending() {
+  const auto now = Clock::now();
+  for (auto it = pending.begin(); it != pending.end();) {
+    char peeked[detail::kMaxHttpHeadBytes + 1];
+    const auto n = ::recv(it->fd, peeked, sizeof peeked, MSG_PEEK | MSG_DONTWAIT);
+    if (n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) {
+      ::close(it->fd);  // left before saying anything
+      it = pending.erase(it);
+      continue;
+    }
+    const std::string_view bytes(peeked, n > 0 ? static_cast<std::size_t>(n) : 0U);
+    auto protocol = detail::sniff_protocol(bytes);
+    if (protocol == detail::WireProtocol::Undecided && now - it->accepted >= kSniffTimeout) {
+      // Silence means a raw RFB client waiting for our greeting; a half-sent HTTP head gets its error.
+      protocol = bytes.empty() ? detail::WireProtocol::Rfb : detail::WireProtocol::Http;
+    }
+    switch (protocol) {
+      case detail::WireProtocol::Undecided:
+        ++it;
+        continue;
+      case detail::WireProtocol::Rfb:
+      case detail::WireProtocol::WebSocket:
+        adopt_rfb(it->fd);
+        break;
+      case detail::WireProtocol::Http:
+        http->serve(it->fd);
+        break;
+    }
+    it = pending.erase(it);
+  }
+}
+
+void Server::Impl::adopt_rfb(int fd) {
+  const int one = 1;
+  ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+  // libvncserver takes the socket over: it runs the WebSocket handshake if there is one, then RFB.
+  // On failure it closes the socket itself.
+  rfbNewClient(screen, fd);
+}
+
+void Server::Impl::apply_newest_frame() {
+  if (!mailbox.take(incoming)) return;
+  const FrameView current{framebuffer.data(), options.width, options.height, 0};
+  const FrameView next{incoming.data(), options.width, options.height, 0};
+  if (damage.compare(current, next) == 0) {
+    ++frames_applied;
+    return;
+  }
+  const std::size_t row_bytes = static_cast<std::size_t>(options.width) * 4U;
+  for (const PixelRect& rect : damage.changed_rects()) {
+    for (int y = rect.y; y < rect.y + rect.h; ++y) {
+      const std::size_t offset = static_cast<std::size_t>(y) * row_bytes + static_cast<std::size_t>(rect.x) * 4U;
+      std::memcpy(framebuffer.data() + offset, incoming.data() + offset, static_cast<std::size_t>(rect.w) * 4U);
+    }
+    rfbMarkRectAsModified(screen, rect.x, rect.y, rect.x + rect.w, rect.y + rect.h);
+  }
+  tiles_changed += static_cast<std::uint64_t>(damage.changed_count());
+  ++frames_applied;
+}
+
+rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
+  Impl& self = of(cl);
+  if (self.clients.load() >= self.options.max_clients) {
+    vnc_error("refusing a client: %d of %d already connected\n", self.clients.load(), self.options.max_clients);
+    return RFB_CLIENT_REFUSE;
+  }
+  auto* state = new ClientState;
+  state->info.id = self.next_client_id++;
+  state->info.address = peer_address(cl->sock);
+  state->info.websocket = cl->wsctx != nullptr;
+  cl->clientData = state;
+  cl->clientGoneHook = on_client_gone;
+  cl->viewOnly = self.options.view_only ? TRUE : FALSE;
+  ++self.clients;
+  if (self.options.on_connect) self.options.on_connect(state->info);
+  return RFB_CLIENT_ACCEPT;
+}
+
+void Server::Impl::on_client_gone(rfbClientPtr cl) {
+  Impl& self = of(cl);
+  auto* state = static_cast<ClientState*>(cl->clientData);
+  if (state == nullptr) return;
+  cl->clientData = nullptr;
+  const int remaining = --self.clients;
+  // Keys this client held would otherwise stay down forever in the simulation.
+  const auto now = Clock::now();
+  for (const auto& release : self.held_keys.release_client(state->info.id, now)) self.input.push(release);
+  if (remaining == 0) {
+    for (const auto& release : self.held_keys.release_all(now)) self.input.push(release);
+  }
+  if (self.options.on_disconnect) self.options.on_disconnect(state->info);
+  delete state;
+}
+
+void Server::Impl::on_key(rfbBool down, rfbKeySym keysym, rfbClientPtr cl) {
+  Impl& self = of(cl);
+  const auto* state = static_cast<ClientState*>(cl->clientData);
+  if (self.options.view_only || state == nullptr) return;
+  InputEvent event;
+  event.kind = InputEvent::Kind::Key;
+  event.time = Clock::now();
+  event.client_id = state->info.id;
+  event.keysym = keysym;
+  event.down = down != 0;
+  self.held_keys.record(event);
+  self.input.push(event);
+}
+
+void Server::Impl::on_pointer(int mask, int x, int y, rfbClientPtr cl) {
+  Impl& self = of(cl);
+  const auto* state = static_cast<ClientState*>(cl->clientData);
+  if (self.options.view_only || state == nullptr) return;
+  InputEvent event;
+  event.kind = InputEvent::Kind::Pointer;
+  event.time = Clock::now();
+  event.client_id = state->info.id;
+  event.x = x;
+  event.y = y;
+  event.buttons = static_cast<std::uint8_t>(mask);
+  self.input.push(event);
+}
+
+void Server::Impl::on_update_start(rfbClientPtr cl) {
+  Impl& self = of(cl);
+  auto* state = static_cast<ClientState*>(cl->clientData);
+  if (state == nullptr) return;
+  state->update_started = Clock::now();
+  state->bytes_before_update = rfbStatGetSentBytes(cl);
+  // Impose the server's JPEG quality and subsampling on Tight clients, whatever level they asked for.
+  if (self.options.jpeg_quality > 0) {
+    cl->turboQualityLevel = self.options.jpeg_quality;
+    cl->turboSubsampLevel = turbo_subsampling_index(self.options.subsampling);
+    cl->tightQualityLevel = std::min(9, self.options.jpeg_quality / 10);
+  }
+}
+
+void Server::Impl::on_update_done(rfbClientPtr cl, int /*result*/) {
+  Impl& self = of(cl);
+  const auto* state = static_cast<ClientState*>(cl->clientData);
+  if (state == nullptr) return;
+  const auto elapsed = Clock::now() - state->update_started;
+  self.encode_ns += static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(elapsed).count());
+  self.bytes_sent += static_cast<std::uint64_t>(std::max(0, rfbStatGetSentBytes(cl) - state->bytes_before_update));
+  ++self.updates_sent;
+}
+
+Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Server::~Server() = default;
+
+int Server::port() const { return impl_->listener.port; }
+
+std::string Server::url() const {
+  const std::string& address = impl_->options.bind_address;
+  const bool ipv6 = address.find(':') != std::string::npos;
+  const std::string host = ipv6 ? "[" + address + "]" : address;
+  if (impl_->options.web_root.empty()) return "vnc://" + host + ":" + std::to_string(port());
+  return "http://" + host + ":" + std::to_string(port()) + "/";
+}
+
+void Server::submit(const FrameView& frame) {
+  if (frame.pixels == nullptr || frame.width != impl_->options.width || frame.height != impl_->options.height) {
+    throw std::invalid_argument("Server::submit: frame is " + std::to_string(frame.width) + "x" +
+                                std::to_string(frame.height) + ", server is " + std::to_string(impl_->options.width) +
+                                "x" + std::to_string(impl_->options.height));
+  }
+  impl_->mailbox.post(frame);
+  ++impl_->frames_submitted;
+  const std::uint64_t one = 1;
+  [[maybe_unused]] auto n = ::write(impl_->wake_fd, &one, sizeof one);
+}
+
+std::vector<InputEvent> Server::poll_input() { return impl_->input.drain(); }
+
+int Server::client_count() const { return impl_->clients.load(); }
+
+ServerStats Server::stats() const {
+  ServerStats s;
+  s.frames_submitted = impl_->frames_submitted.load();
+  s.frames_applied = impl_->frames_applied.load();
+  s.tiles_changed = impl_->tiles_changed.load();
+  s.updates_sent = impl_->updates_sent.load();
+  s.bytes_sent = impl_->bytes_sent.load();
+  s.encode_ms = static_cast<double>(impl_->encode_ns.load()) / 1e6;
+  s.http_requests = impl_->http->requests();
+  s.clients = impl_->clients.load();
+  return s;
+}
+
+const ServerOptions& Server::options() const { return impl_->options; }
+
+}  // namespace rfbsim

@@ -1,0 +1,165 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// sim_rfb: one participant's simulation, rendered off-screen and served to the browser.
+//
+// The main thread is the simulation thread: it owns the GL context, steps the world at a fixed rate,
+// and renders at the frame rate only while someone is watching. librfbsim's own thread does the network.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/options.hpp"
+#include "app/simulation.hpp"
+#include "render/gl_renderer.hpp"
+#include "render/scene_builder.hpp"
+#include "rfbsim/offscreen_gl.hpp"
+#include "rfbsim/server.hpp"
+#include "world/demo_world.hpp"
+#include "world/fixed_step_clock.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+void request_stop(int /*signal*/) { g_stop = true; }
+
+void install_signal_handlers() {
+  struct sigaction action {};
+  action.sa_handler = request_stop;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+// The page: --web-root if given, else the one built beside this binary, else the installed one.
+std::string find_web_root(const std::string& requested) {
+  if (!requested.empty()) return requested;
+  for (const char* candidate : {RFBSIM_BUILD_WEB_ROOT, RFBSIM_INSTALLED_WEB_ROOT}) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(std::filesystem::path(candidate) / "index.html", ec)) return candidate;
+  }
+  throw std::runtime_error(std::string("no participant page found (looked in ") + RFBSIM_BUILD_WEB_ROOT + " and " +
+                           RFBSIM_INSTALLED_WEB_ROOT + "); run 'npm ci --prefix web' and rebuild, or pass --web-root");
+}
+
+// The latest status document, written by the simulation thread and read by HTTP workers.
+class StatusBoard {
+ public:
+  void publish(std::string text) {
+    std::lock_guard lock(mutex_);
+    text_ = std::move(text);
+  }
+  std::string read() const {
+    std::lock_guard lock(mutex_);
+    return text_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::string text_ = "{}";
+};
+
+int run(const rfbsim::sim::SimOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  namespace sim = rfbsim::sim;
+
+  StatusBoard status;
+  rfbsim::ServerOptions server_options;
+  server_options.port = options.port;
+  server_options.bind_address = options.bind;
+  server_options.width = options.width;
+  server_options.height = options.height;
+  server_options.jpeg_quality = options.jpeg_quality;
+  server_options.max_clients = options.max_clients;
+  server_options.desktop_name = "rfbsim";
+  server_options.web_root = find_web_root(options.web_root);
+  server_options.json_routes["/status.json"] = [&status] { return status.read(); };
+  server_options.on_connect = [](const rfbsim::ClientInfo& c) {
+    std::fprintf(stderr, "[sim_rfb] client %d connected from %s (%s)\n", c.id, c.address.c_str(),
+                 c.websocket ? "websocket" : "rfb");
+  };
+  server_options.on_disconnect = [](const rfbsim::ClientInfo& c) {
+    std::fprintf(stderr, "[sim_rfb] client %d disconnected\n", c.id);
+  };
+  rfbsim::Server server(std::move(server_options));
+
+  rfbsim::OffscreenGLOptions gl_options;
+  gl_options.width = options.width;
+  gl_options.height = options.height;
+  gl_options.platform = options.egl_platform;
+  rfbsim::OffscreenGL gl(gl_options);
+  sim::GlRenderer renderer;
+  std::fprintf(stderr, "[sim_rfb] rendering with %s\n", gl.renderer().c_str());
+
+  sim::SimulationParams params;
+  params.dt = 1.0 / options.tick_hz;
+  sim::Simulation simulation(params, sim::make_demo_world());
+  sim::FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / options.tick_hz));
+  const auto frame_interval = std::chrono::nanoseconds(1'000'000'000LL / options.fps);
+  std::uint64_t frames_rendered = 0;
+
+  std::printf("sim_rfb ready: %s\n", server.url().c_str());
+  std::fflush(stdout);
+
+  auto last = Clock::now();
+  auto next_frame = last;
+  while (!g_stop) {
+    const auto now = Clock::now();
+    const int ticks = clock.advance(now - last);
+    last = now;
+
+    // Input drained now takes effect from the next tick.
+    for (const rfbsim::InputEvent& event : server.poll_input()) {
+      if (event.kind == rfbsim::InputEvent::Kind::Key) simulation.apply_key(event.keysym, event.down);
+    }
+    for (int i = 0; i < ticks; ++i) simulation.step();
+    const int clients = server.client_count();
+    if (ticks > 0) status.publish(sim::status_json(simulation.world(), clients, frames_rendered));
+
+    // Render only for a viewer, at the frame rate.
+    if (clients == 0) {
+      next_frame = now;
+    } else if (now >= next_frame) {
+      gl.begin_frame();
+      renderer.draw(sim::build_scene(simulation.world()), gl.width(), gl.height());
+      server.submit(gl.read_frame());
+      ++frames_rendered;
+      next_frame += frame_interval;
+      if (next_frame < now) next_frame = now + frame_interval;  // fell behind: skip, do not burst
+    }
+    auto wake = now + clock.until_next_step();
+    if (clients > 0) wake = std::min(wake, next_frame);
+    std::this_thread::sleep_until(wake);
+  }
+  std::fprintf(stderr, "[sim_rfb] stopping after %llu ticks, %llu frames\n",
+               static_cast<unsigned long long>(simulation.world().tick),
+               static_cast<unsigned long long>(frames_rendered));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  const auto parsed = rfbsim::sim::parse_sim_options(args);
+  if (!parsed.error.empty()) {
+    std::fprintf(stderr, "sim_rfb: %s\n%s", parsed.error.c_str(), rfbsim::sim::sim_usage().c_str());
+    return 2;
+  }
+  if (parsed.options.help) {
+    std::fputs(rfbsim::sim::sim_usage().c_str(), stdout);
+    return 0;
+  }
+  install_signal_handlers();
+  try {
+    return run(parsed.options);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "sim_rfb: error: %s\n", error.what());
+    return 1;
+  }
+}

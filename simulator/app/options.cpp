@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// sim_rfb's command-line parser.
+#include "app/options.hpp"
+
+#include <charconv>
+#include <functional>
+#include <map>
+
+namespace rfbsim::sim {
+
+namespace {
+
+template <typename T>
+bool parse_number(const std::string& text, T low, T high, T& out) {
+  T value{};
+  const auto* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc() || ptr != end || value < low || value > high) return false;
+  out = value;
+  return true;
+}
+
+}  // namespace
+
+std::string sim_usage() {
+  return "usage: sim_rfb [--port N] [--bind ADDR] [--width W] [--height H] [--fps F] [--seed S]\n"
+         "               [--quality Q] [--max-clients N] [--web-root DIR] [--egl auto|device|surfaceless]\n"
+         "  --port N         TCP port for the page, WebSocket and RFB (default 5901; 0 = any free port)\n"
+         "  --bind ADDR      numeric address to listen on (default 127.0.0.1)\n"
+         "  --width W        frame width in pixels, 160..3840 (default 1280)\n"
+         "  --height H       frame height in pixels, 120..2160 (default 720)\n"
+         "  --fps F          frames per second while someone watches, 1..120 (default 30)\n"
+         "  --seed S         random seed (default 1)\n"
+         "  --quality Q      JPEG quality 1..100 (default 80)\n"
+         "  --max-clients N  viewers at once, 1..64 (default 4)\n"
+         "  --web-root DIR   directory holding the participant page (default: the built page)\n"
+         "  --egl P          EGL platform (default auto: GPU device, else Mesa surfaceless)\n";
+}
+
+ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
+  ParseOutcome outcome;
+  SimOptions& o = outcome.options;
+  // Each option that takes a value: its parser returns false when the value is bad.
+  const std::map<std::string, std::function<bool(const std::string&)>> with_value = {
+      {"--port", [&](const std::string& v) { return parse_number(v, 0, 65535, o.port); }},
+      {"--bind", [&](const std::string& v) { o.bind = v; return !v.empty(); }},
+      {"--width", [&](const std::string& v) { return parse_number(v, 160, 3840, o.width); }},
+      {"--height", [&](const std::string& v) { return parse_number(v, 120, 2160, o.height); }},
+      {"--fps", [&](const std::string& v) { return parse_number(v, 1, 120, o.fps); }},
+      {"--seed", [&](const std::string& v) { return parse_number<std::uint64_t>(v, 0, UINT64_MAX, o.seed); }},
+      {"--quality", [&](const std::string& v) { return parse_number(v, 1, 100, o.jpeg_quality); }},
+      {"--max-clients", [&](const std::string& v) { return parse_number(v, 1, 64, o.max_clients); }},
+      {"--web-root", [&](const std::string& v) { o.web_root = v; return !v.empty(); }},
+      {"--egl", [&](const std::string& v) {
+         o.egl_platform = v;
+         return v == "auto" || v == "device" || v == "surfaceless";
+       }},
+  };
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg == "--help" || arg == "-h") {
+      o.help = true;
+      continue;
+    }
+    auto option = with_value.find(arg);
+    if (option == with_value.end()) {
+      outcome.error = "unknown argument '" + arg + "'";
+      return outcome;
+    }
+    if (i + 1 >= args.size()) {
+      outcome.error = arg + " needs a value";
+      return outcome;
+    }
+    const std::string& value = args[++i];
+    if (!option->second(value)) {
+      outcome.error = "bad value '" + value + "' for " + arg;
+      return outcome;
+    }
+  }
+  return outcome;
+}
+
+}  // namespace rfbsim::sim

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// sim_rfb's command line: parsed and validated without side effects, so that it can be unit-tested.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rfbsim::sim {
+
+/// Everything sim_rfb can be told on its command line.
+struct SimOptions {
+  int port = 5901;                  ///< 0 = any free port
+  std::string bind = "127.0.0.1";   ///< listen address; loopback unless told otherwise
+  int width = 1280;                 ///< frame width, pixels
+  int height = 720;                 ///< frame height, pixels
+  int fps = 30;                     ///< frames rendered per second while a client is connected
+  int tick_hz = 60;                 ///< fixed simulation steps per second
+  std::uint64_t seed = 1;           ///< master seed for every random stream
+  int jpeg_quality = 80;            ///< 1..100
+  int max_clients = 4;
+  std::string web_root;             ///< empty = the built or installed page
+  std::string egl_platform = "auto";
+  bool help = false;
+};
+
+/// The outcome of parsing: options, or a message naming the bad argument.
+struct ParseOutcome {
+  SimOptions options;
+  std::string error;  ///< empty on success
+};
+
+/// Parses argv (without the program name). Never throws; never exits.
+ParseOutcome parse_sim_options(const std::vector<std::string>& args);
+
+/// The --help text.
+std::string sim_usage();
+
+}  // namespace rfbsim::sim

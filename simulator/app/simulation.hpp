@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Simulation: the model (parameters, fixed step) and the state (World) of one session, stepped by ticks.
+// No GL and no network: the app feeds it key events and reads the world to draw and report it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "avatar/avatar_controls.hpp"
+#include "avatar/avatar_motion.hpp"
+#include "world/world.hpp"
+
+namespace rfbsim::sim {
+
+/// What does not change during a session.
+struct SimulationParams {
+  double dt = 1.0 / 60.0;  ///< s per tick
+  AvatarParams avatar;
+  CameraParams camera;
+};
+
+class Simulation {
+ public:
+  Simulation(SimulationParams params, World initial);
+
+  /// Applies one key event; it takes effect from the next step.
+  void apply_key(std::uint32_t keysym, bool down) { controls_.apply_key(keysym, down); }
+  /// Releases every control (the participant left).
+  void release_controls() { controls_.release_all(); }
+  /// Advances one fixed tick: avatar, camera, clock.
+  void step();
+
+  [[nodiscard]] const World& world() const { return world_; }
+  [[nodiscard]] const SimulationParams& params() const { return params_; }
+  [[nodiscard]] const ControlState& controls() const { return controls_.state(); }
+
+ private:
+  SimulationParams params_;
+  World world_;
+  AvatarControls controls_;
+};
+
+/// The status document served at /status.json: tick, time, avatar pose, camera height, plus what the
+/// caller adds about clients and frames.
+std::string status_json(const World& world, int clients, std::uint64_t frames_rendered);
+
+}  // namespace rfbsim::sim
