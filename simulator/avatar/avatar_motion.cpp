@@ -12,8 +12,8 @@ void step_avatar(const AvatarParams& params, const ControlState& controls, const
                  Avatar& avatar) {
   // Commanded speeds: opposite keys cancel.
   double target_speed = 0.0;
-  if (controls.forward) target_speed += params.walk_speed;
-  if (controls.backward) target_speed -= params.backward_speed;
+  if (controls.forward && !controls.backward) target_speed = params.walk_speed;
+  if (controls.backward && !controls.forward) target_speed = -params.backward_speed;
   double yaw_rate = 0.0;
   if (controls.turn_left) yaw_rate += params.turn_rate;
   if (controls.turn_right) yaw_rate -= params.turn_rate;

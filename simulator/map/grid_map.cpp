@@ -32,6 +32,17 @@ bool GridMap::disc_hits_wall(double x, double y, double radius) const {
   return false;
 }
 
+double GridMap::free_distance(double x, double y, double dx, double dy, double max_distance, double radius) const {
+  const double step = resolution / 10.0;
+  double travelled = 0.0;
+  while (travelled < max_distance) {
+    const double next = std::min(travelled + step, max_distance);
+    if (disc_hits_wall(x + dx * next, y + dy * next, radius)) return travelled;
+    travelled = next;
+  }
+  return max_distance;
+}
+
 std::vector<WallRun> merge_wall_runs(const GridMap& map) {
   std::vector<WallRun> runs;
   for (int row = 0; row < map.height; ++row) {

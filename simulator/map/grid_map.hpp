@@ -24,6 +24,10 @@ struct GridMap {
   [[nodiscard]] int row_of(double y) const;
   /// Whether a disc of `radius` at (x, y) overlaps any wall cell.
   [[nodiscard]] bool disc_hits_wall(double x, double y, double radius) const;
+  /// How far a disc of `radius` can travel from (x, y) along the unit direction (dx, dy) before it
+  /// touches a wall, up to `max_distance`, in steps of a tenth of a cell.
+  [[nodiscard]] double free_distance(double x, double y, double dx, double dy, double max_distance,
+                                     double radius) const;
 };
 
 /// A horizontal run of wall cells in one row: the unit walls are drawn with.

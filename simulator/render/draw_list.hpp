@@ -43,7 +43,7 @@ struct ViewCamera {
 struct Scene {
   ViewCamera camera;
   Eigen::Vector3f sky{0.62f, 0.72f, 0.82f};     ///< background and fog colour
-  Eigen::Vector3f sun_direction{-0.4f, -0.3f, -1.0f};  ///< direction the light travels
+  Eigen::Vector3f sun_direction{0.35f, 0.6f, -1.0f};   ///< direction the light travels
   float fog_start = 12.0f;                       ///< m from the eye
   float fog_end = 40.0f;
   std::vector<DrawItem> items;

@@ -59,7 +59,7 @@ void main() {
     base *= mix(0.7, 1.0, smoothstep(0.0, 0.8, v_world.z));
   }
   float hemi = 0.5 + 0.5 * n.z;
-  vec3 ambient = mix(vec3(0.30, 0.28, 0.26), vec3(0.50, 0.55, 0.62), hemi);
+  vec3 ambient = mix(vec3(0.36, 0.34, 0.32), vec3(0.55, 0.58, 0.64), hemi);
   float sun = max(dot(n, -u_sun), 0.0);
   vec3 lit = base * (ambient + 0.75 * sun * vec3(1.0, 0.97, 0.9));
   float fog = smoothstep(u_fog.x, u_fog.y, distance(v_world, u_eye));

@@ -113,8 +113,10 @@ Scene build_scene(const World& world, const SceneStyle& style) {
   scene.items.push_back(shadow);
 
   // Third-person camera: behind the avatar at the rig's height, looking at its chest a little ahead.
+  // It comes closer rather than pass through a wall behind the avatar.
   const Eigen::Vector3f heading{std::cos(yaw), std::sin(yaw), 0.0f};
-  const auto distance = static_cast<float>(world.camera.distance);
+  const auto distance = static_cast<float>(map.free_distance(avatar.pose.x, avatar.pose.y, -std::cos(avatar.pose.yaw),
+                                                             -std::sin(avatar.pose.yaw), world.camera.distance, 0.15));
   scene.camera.eye = feet - heading * distance + Eigen::Vector3f(0.0f, 0.0f, static_cast<float>(world.camera.height));
   scene.camera.target = feet + heading * 1.0f + Eigen::Vector3f(0.0f, 0.0f, 1.1f);
   return scene;

@@ -18,7 +18,7 @@ World make_demo_world() {
       {5.0, 3.2, 0.8, 1.4, 1.0, 0x5a78a0},
       {-4.5, 3.5, 0.8, 0.8, 1.6, 0xb08850},
   };
-  world.avatar.pose = {3.5, -3.0, std::numbers::pi / 2.0};
+  world.avatar.pose = {3.5, -1.0, std::numbers::pi / 2.0};
   return world;
 }
 

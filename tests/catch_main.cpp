@@ -1,0 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The Catch2 v2 main() shared by every test executable.
+#define CATCH_CONFIG_MAIN
+#include <catch2/catch.hpp>

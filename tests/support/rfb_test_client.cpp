@@ -1,0 +1,160 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// RfbTestClient over libvncclient, plus small loopback HTTP helpers for tests.
+#include "rfb_test_client.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <rfb/rfbclient.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+namespace rfbsim::test {
+
+namespace {
+
+int g_tag = 0;  // address used as libvncclient's client-data tag
+
+void quiet_log(const char* /*format*/, ...) {}
+
+// libvncclient allocates the framebuffer through this hook; we keep it in a vector we own.
+rfbBool resize_framebuffer(rfbClient* client) {
+  auto* self = static_cast<std::vector<std::uint8_t>*>(rfbClientGetClientData(client, &g_tag + 1));
+  self->assign(static_cast<std::size_t>(client->width) * static_cast<std::size_t>(client->height) * 4U, 0);
+  client->frameBuffer = self->data();
+  client->updateRect.x = client->updateRect.y = 0;
+  client->updateRect.w = client->width;
+  client->updateRect.h = client->height;
+  SetFormatAndEncodings(client);
+  return TRUE;
+}
+
+}  // namespace
+
+RfbTestClient::RfbTestClient(const std::string& host, int port, int quality) {
+  if (std::getenv("RFBSIM_VNC_LOG") == nullptr) {
+    rfbClientLog = quiet_log;
+    rfbClientErr = quiet_log;
+  }
+  client_ = rfbGetClient(8, 3, 4);  // RGBX bytes: red in the lowest byte, as rfbsim serves
+  client_->serverHost = strdup(host.c_str());
+  client_->serverPort = port;
+  client_->appData.encodingsString = "tight copyrect";
+  client_->appData.compressLevel = 1;
+  client_->appData.qualityLevel = quality;
+  client_->appData.enableJPEG = TRUE;
+  client_->appData.useRemoteCursor = FALSE;
+  client_->canHandleNewFBSize = FALSE;
+  client_->MallocFrameBuffer = resize_framebuffer;
+  client_->FinishedFrameBufferUpdate = on_update_finished;
+  rfbClientSetClientData(client_, &g_tag, this);
+  rfbClientSetClientData(client_, &g_tag + 1, &pixels_);
+  // On failure rfbInitClient frees the client itself.
+  if (!rfbInitClient(client_, nullptr, nullptr)) {
+    client_ = nullptr;
+    throw std::runtime_error("RFB connection to " + host + ":" + std::to_string(port) + " failed");
+  }
+  connected_ = true;
+}
+
+RfbTestClient::~RfbTestClient() {
+  if (client_ != nullptr) {
+    client_->frameBuffer = nullptr;  // ours, not libvncclient's
+    rfbClientCleanup(client_);
+  }
+}
+
+void RfbTestClient::on_update_finished(rfbClient* client) {
+  auto* self = static_cast<RfbTestClient*>(rfbClientGetClientData(client, &g_tag));
+  ++self->updates_;
+}
+
+bool RfbTestClient::pump_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!done()) {
+    if (!connected_ || std::chrono::steady_clock::now() >= deadline) return done();
+    const int ready = WaitForMessage(client_, 20000);  // microseconds
+    if (ready < 0) {
+      connected_ = false;
+    } else if (ready > 0 && !HandleRFBServerMessage(client_)) {
+      connected_ = false;
+    }
+  }
+  return true;
+}
+
+bool RfbTestClient::wait_for_updates(std::uint64_t count, std::chrono::milliseconds timeout) {
+  const std::uint64_t target = updates_ + count;
+  return pump_until([&] { return updates_ >= target; }, timeout);
+}
+
+int RfbTestClient::width() const { return client_->width; }
+int RfbTestClient::height() const { return client_->height; }
+
+FrameView RfbTestClient::frame() const { return FrameView{pixels_.data(), client_->width, client_->height, 0}; }
+
+std::string RfbTestClient::desktop_name() const { return client_->desktopName ? client_->desktopName : ""; }
+
+void RfbTestClient::send_key(std::uint32_t keysym, bool down) { SendKeyEvent(client_, keysym, down ? TRUE : FALSE); }
+
+void RfbTestClient::send_pointer(int x, int y, int buttons) { SendPointerEvent(client_, x, y, buttons); }
+
+double mean_abs_difference(const FrameView& a, const FrameView& b) {
+  if (a.width != b.width || a.height != b.height) return std::numeric_limits<double>::infinity();
+  double sum = 0.0;
+  for (int y = 0; y < a.height; ++y) {
+    const std::uint8_t* ra = a.row(y);
+    const std::uint8_t* rb = b.row(y);
+    for (int x = 0; x < a.width; ++x) {
+      for (int c = 0; c < 3; ++c) sum += std::abs(int{ra[x * 4 + c]} - int{rb[x * 4 + c]});
+    }
+  }
+  return sum / (3.0 * a.width * a.height);
+}
+
+std::string http_get(int port, const std::string& path, std::chrono::milliseconds timeout) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<std::uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
+    ::close(fd);
+    return {};
+  }
+  const std::string request = "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
+  ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+  std::string response;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    pollfd pfd{fd, POLLIN, 0};
+    if (left.count() <= 0 || ::poll(&pfd, 1, static_cast<int>(left.count())) <= 0) break;
+    char buffer[4096];
+    const auto n = ::recv(fd, buffer, sizeof buffer, 0);
+    if (n <= 0) break;
+    response.append(buffer, static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  return response;
+}
+
+std::string http_body(const std::string& response) {
+  const auto blank = response.find("\r\n\r\n");
+  return blank == std::string::npos ? std::string() : response.substr(blank + 4);
+}
+
+double json_number(const std::string& json, const std::string& key) {
+  const std::string needle = "\"" + key + "\":";
+  const auto at = json.find(needle);
+  if (at == std::string::npos) return std::numeric_limits<double>::quiet_NaN();
+  return std::strtod(json.c_str() + at + needle.size(), nullptr);
+}
+
+}  // namespace rfbsim::test

@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// SimProcess: fork + execv, a stdout pipe, SIGTERM and waitpid.
+#include "sim_process.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <regex>
+#include <stdexcept>
+#include <thread>
+
+namespace rfbsim::test {
+
+std::string sim_rfb_path() {
+  const char* from_env = std::getenv("RFBSIM_SIM_RFB");
+#ifdef RFBSIM_SIM_RFB_DEFAULT
+  return from_env != nullptr ? from_env : RFBSIM_SIM_RFB_DEFAULT;
+#else
+  return from_env != nullptr ? from_env : "sim_rfb";
+#endif
+}
+
+SimProcess::SimProcess(const std::string& program, const std::vector<std::string>& args,
+                       std::chrono::milliseconds timeout) {
+  int pipe_fds[2];
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  std::vector<std::string> argv_strings{program};
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& s : argv_strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+
+  pid_ = ::fork();
+  if (pid_ < 0) throw std::runtime_error("fork failed");
+  if (pid_ == 0) {
+    ::dup2(pipe_fds[1], STDOUT_FILENO);
+    ::execv(program.c_str(), argv.data());
+    _exit(127);
+  }
+  ::close(pipe_fds[1]);
+  stdout_fd_ = pipe_fds[0];
+
+  // Read stdout until the ready line names the URL.
+  std::string output;
+  const std::regex ready(R"(ready: (http://[^:/\s]+:(\d+)/))");
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  std::smatch match;
+  while (!std::regex_search(output, match, ready)) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    pollfd pfd{stdout_fd_, POLLIN, 0};
+    if (left.count() <= 0 || ::poll(&pfd, 1, static_cast<int>(left.count())) <= 0) {
+      stop(SIGKILL);
+      throw std::runtime_error("sim_rfb printed no ready line in time; output so far: " + output);
+    }
+    char buffer[512];
+    const auto n = ::read(stdout_fd_, buffer, sizeof buffer);
+    if (n <= 0) {
+      stop(SIGKILL);
+      throw std::runtime_error("sim_rfb exited before it was ready; output: " + output);
+    }
+    output.append(buffer, static_cast<std::size_t>(n));
+  }
+  url_ = match[1];
+  port_ = std::stoi(match[2]);
+}
+
+SimProcess::~SimProcess() {
+  if (!reaped_) stop(SIGKILL, std::chrono::seconds(5));
+  if (stdout_fd_ >= 0) ::close(stdout_fd_);
+}
+
+bool SimProcess::running() {
+  if (reaped_) return false;
+  int status = 0;
+  if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+    reaped_ = true;
+    return false;
+  }
+  return true;
+}
+
+int SimProcess::stop(int signal, std::chrono::milliseconds timeout) {
+  if (reaped_ || pid_ <= 0) return -1;
+  ::kill(pid_, signal);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    int status = 0;
+    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+      reaped_ = true;
+      return status;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return -1;
+}
+
+}  // namespace rfbsim::test
