@@ -103,6 +103,8 @@ int run(const rfbsim::sim::SimOptions& options) {
   const auto frame_interval = std::chrono::nanoseconds(1'000'000'000LL / options.fps);
   std::uint64_t frames_rendered = 0;
 
+  // Readers of /status.json never see an empty document, even before the first tick.
+  status.publish(sim::status_json(simulation.world(), 0, 0));
   std::printf("sim_rfb ready: %s\n", server.url().c_str());
   std::fflush(stdout);
 

@@ -24,6 +24,46 @@ std::string sim_rfb_path() {
 #endif
 }
 
+ExitResult run_to_exit(const std::string& program, const std::vector<std::string>& args,
+                       std::chrono::milliseconds timeout) {
+  int pipe_fds[2];
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  std::vector<std::string> argv_strings{program};
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& s : argv_strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    ::dup2(pipe_fds[1], STDOUT_FILENO);
+    ::dup2(pipe_fds[1], STDERR_FILENO);
+    ::execv(program.c_str(), argv.data());
+    _exit(127);
+  }
+  ::close(pipe_fds[1]);
+  ExitResult result;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  // Read until end of file (the child exited and closed its end) or the deadline.
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    pollfd pfd{pipe_fds[0], POLLIN, 0};
+    if (left.count() <= 0 || ::poll(&pfd, 1, static_cast<int>(left.count())) <= 0) {
+      ::kill(pid, SIGKILL);
+      break;
+    }
+    char buffer[512];
+    const auto n = ::read(pipe_fds[0], buffer, sizeof buffer);
+    if (n <= 0) break;
+    result.output.append(buffer, static_cast<std::size_t>(n));
+  }
+  ::close(pipe_fds[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  result.status = std::chrono::steady_clock::now() < deadline ? status : -1;
+  return result;
+}
+
 SimProcess::SimProcess(const std::string& program, const std::vector<std::string>& args,
                        std::chrono::milliseconds timeout) {
   int pipe_fds[2];

@@ -38,6 +38,16 @@ class SimProcess {
   bool reaped_ = false;
 };
 
+/// What a finished command did: its wait status (WIFEXITED etc.) and its stdout and stderr together.
+struct ExitResult {
+  int status = -1;  ///< -1 if it did not exit in time (it is then killed)
+  std::string output;
+};
+
+/// Runs `program` with `args` (no shell) to completion, at most `timeout`.
+ExitResult run_to_exit(const std::string& program, const std::vector<std::string>& args,
+                       std::chrono::milliseconds timeout = std::chrono::seconds(30));
+
 /// The path of the sim_rfb binary under test (from the RFBSIM_SIM_RFB environment variable or the
 /// compiled-in default).
 std::string sim_rfb_path();

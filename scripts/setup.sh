@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
+# Installs what rfbsim needs on Debian 12 (only what is missing), installs the page's npm packages from
+# the lock file, and builds. Used by run-demo.sh and test.sh; safe to run again.
+#   scripts/setup.sh [--with-browser] [--build-dir DIR] [extra cmake -D options...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+with_browser=0
+build_dir=build
+cmake_args=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --with-browser) with_browser=1 ;;
+    --build-dir) build_dir="$2"; shift ;;
+    -D*) cmake_args+=("$1") ;;
+    *) echo "setup.sh: unknown argument '$1'" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+# Debian packages: the build's libraries and tools. Chromium only for the browser tests.
+packages=(build-essential cmake ninja-build pkg-config git
+  libvncserver-dev libegl-dev libgl-dev libopengl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm-dev
+  libode-dev libeigen3-dev libwebsocketpp-dev libboost-system-dev libasio-dev catch2 libssl-dev)
+command -v node >/dev/null 2>&1 || packages+=(nodejs)
+command -v npm >/dev/null 2>&1 || packages+=(npm)
+[ "$with_browser" = 1 ] && packages+=(chromium)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=()
+  [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# The page's npm packages, exactly as locked (noVNC; playwright-core drives Debian's Chromium in tests).
+if [ ! -f web/node_modules/.package-lock.json ] || ! cmp -s web/package-lock.json web/.installed-lock.json; then
+  echo "setup: npm ci in web/"
+  npm ci --prefix web --no-audit --no-fund --loglevel=error
+  cp web/package-lock.json web/.installed-lock.json
+fi
+
+generator=()
+command -v ninja >/dev/null 2>&1 && [ ! -f "$build_dir/CMakeCache.txt" ] && generator=(-G Ninja)
+cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo "${cmake_args[@]}"
+cmake --build "$build_dir" -j "$(nproc)"
