@@ -57,13 +57,6 @@ void vnc_log(const char* format, ...) {
   std::vfprintf(stderr, format, args);
   va_end(args);
 }
-void vnc_error(const char* format, ...) {
-  std::fputs("[rfbsim.vnc] ", stderr);
-  va_list args;
-  va_start(args, format);
-  std::vfprintf(stderr, format, args);
-  va_end(args);
-}
 
 // libvncserver's index of Tight subsampling levels: 0 = 4:4:4, 1 = 4:2:0, 2 = 4:2:2, 3 = grey.
 int turbo_subsampling_index(Subsampling s) {
@@ -171,8 +164,10 @@ Server::Impl::Impl(ServerOptions o)
     : options(validated(std::move(o))),
       mailbox(options.width, options.height),
       damage(options.width, options.height) {
+  // libvncserver reports ordinary disconnects ("read: Connection reset by peer") on its error channel
+  // too, so both channels stay quiet unless RFBSIM_VNC_LOG is set; our own failures are reported below.
   rfbLog = vnc_log;
-  rfbErr = vnc_error;
+  rfbErr = vnc_log;
 
   listener = detail::open_listener(options.bind_address, options.port);
   wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -348,7 +343,8 @@ void Server::Impl::apply_newest_frame() {
 rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
   Impl& self = of(cl);
   if (self.clients.load() >= self.options.max_clients) {
-    vnc_error("refusing a client: %d of %d already connected\n", self.clients.load(), self.options.max_clients);
+    std::fprintf(stderr, "[rfbsim.server] refusing a client: %d of %d already connected\n", self.clients.load(),
+                 self.options.max_clients);
     return RFB_CLIENT_REFUSE;
   }
   auto* state = new ClientState;
@@ -425,9 +421,14 @@ void Server::Impl::on_update_done(rfbClientPtr cl, int /*result*/) {
   Impl& self = of(cl);
   const auto* state = static_cast<ClientState*>(cl->clientData);
   if (state == nullptr) return;
+  // libvncserver's byte counter is an int that wraps after 2 GiB: subtract as unsigned 32-bit.
+  const std::uint32_t sent = static_cast<std::uint32_t>(rfbStatGetSentBytes(cl)) -
+                             static_cast<std::uint32_t>(state->bytes_before_update);
+  // The hook also runs when libvncserver found nothing to send; that is no update.
+  if (sent == 0) return;
   const auto elapsed = Clock::now() - state->update_started;
   self.encode_ns += static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(elapsed).count());
-  self.bytes_sent += static_cast<std::uint64_t>(std::max(0, rfbStatGetSentBytes(cl) - state->bytes_before_update));
+  self.bytes_sent += sent;
   ++self.updates_sent;
 }
 

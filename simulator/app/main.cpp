@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -102,6 +103,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   sim::FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / options.tick_hz));
   const auto frame_interval = std::chrono::nanoseconds(1'000'000'000LL / options.fps);
   std::uint64_t frames_rendered = 0;
+  std::optional<sim::Scene> last_drawn;  // the server keeps showing it; an equal scene is not drawn again
 
   // Readers of /status.json never see an empty document, even before the first tick.
   status.publish(sim::status_json(simulation.world(), 0, 0));
@@ -127,10 +129,14 @@ int run(const rfbsim::sim::SimOptions& options) {
     if (clients == 0) {
       next_frame = now;
     } else if (now >= next_frame) {
-      gl.begin_frame();
-      renderer.draw(sim::build_scene(simulation.world()), gl.width(), gl.height());
-      server.submit(gl.read_frame());
-      ++frames_rendered;
+      sim::Scene scene = sim::build_scene(simulation.world());
+      if (!last_drawn || !sim::same_scene(scene, *last_drawn)) {
+        gl.begin_frame();
+        renderer.draw(scene, gl.width(), gl.height());
+        server.submit(gl.read_frame());
+        ++frames_rendered;
+        last_drawn = std::move(scene);
+      }
       next_frame += frame_interval;
       if (next_frame < now) next_frame = now + frame_interval;  // fell behind: skip, do not burst
     }

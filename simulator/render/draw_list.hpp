@@ -49,4 +49,22 @@ struct Scene {
   std::vector<DrawItem> items;
 };
 
+/// Whether two scenes would draw the same picture (exact comparison). The app skips rendering a frame
+/// whose scene equals the last one drawn: an idle view costs no GPU or CPU time.
+inline bool same_scene(const Scene& a, const Scene& b) {
+  const auto same_item = [](const DrawItem& x, const DrawItem& y) {
+    return x.shape == y.shape && x.surface == y.surface && x.model.matrix() == y.model.matrix() &&
+           x.color == y.color && x.opacity == y.opacity;
+  };
+  if (a.camera.eye != b.camera.eye || a.camera.target != b.camera.target ||
+      a.camera.fov_y_degrees != b.camera.fov_y_degrees || a.sky != b.sky || a.sun_direction != b.sun_direction ||
+      a.fog_start != b.fog_start || a.fog_end != b.fog_end || a.items.size() != b.items.size()) {
+    return false;
+  }
+  for (std::size_t i = 0; i < a.items.size(); ++i) {
+    if (!same_item(a.items[i], b.items[i])) return false;
+  }
+  return true;
+}
+
 }  // namespace rfbsim::sim

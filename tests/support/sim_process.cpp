@@ -5,13 +5,13 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <regex>
 #include <stdexcept>
-#include <thread>
 
 namespace rfbsim::test {
 
@@ -125,15 +125,18 @@ bool SimProcess::running() {
 
 int SimProcess::stop(int signal, std::chrono::milliseconds timeout) {
   if (reaped_ || pid_ <= 0) return -1;
+  // A pidfd becomes readable when the process exits: wait on that instead of polling waitpid.
+  const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, pid_, 0));
   ::kill(pid_, signal);
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-      reaped_ = true;
-      return status;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (pidfd >= 0) {
+    pollfd pfd{pidfd, POLLIN, 0};
+    ::poll(&pfd, 1, static_cast<int>(timeout.count()));
+    ::close(pidfd);
+  }
+  int status = 0;
+  if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+    reaped_ = true;
+    return status;
   }
   return -1;
 }

@@ -68,3 +68,14 @@ TEST_CASE("the demo scene renders sky above and the avatar's blue shirt at the c
   CHECK(shirt);
   CHECK(renderer.last_triangles() > 100);
 }
+
+TEST_CASE("scenes compare equal until the world moves") {
+  auto world = rfbsim::sim::make_demo_world();
+  const auto a = rfbsim::sim::build_scene(world);
+  CHECK(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
+  world.avatar.pose.x += 0.001;
+  CHECK_FALSE(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
+  world = rfbsim::sim::make_demo_world();
+  world.camera.height += 0.1;
+  CHECK_FALSE(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
+}
