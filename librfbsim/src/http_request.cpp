@@ -116,7 +116,10 @@ HttpParseResult parse_http_request(std::string_view bytes, std::size_t max_head_
 }
 
 WireProtocol sniff_protocol(std::string_view first_bytes) {
-  static constexpr std::array<std::string_view, 2> kHttpMethods = {"GET ", "HEAD "};
+  // Every method, so that the HTTP side answers the unsupported ones with 405 instead of libvncserver
+  // closing them without a word. None of these can begin an RFB client's first message.
+  static constexpr std::array<std::string_view, 9> kHttpMethods = {
+      "GET ", "HEAD ", "POST ", "PUT ", "DELETE ", "OPTIONS ", "PATCH ", "TRACE ", "CONNECT "};
   bool could_be_http = false;
   for (const auto method : kHttpMethods) {
     const auto n = std::min(first_bytes.size(), method.size());

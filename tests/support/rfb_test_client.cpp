@@ -43,6 +43,7 @@ RfbTestClient::RfbTestClient(const std::string& host, int port, int quality) {
     rfbClientErr = quiet_log;
   }
   client_ = rfbGetClient(8, 3, 4);  // RGBX bytes: red in the lowest byte, as rfbsim serves
+  free(client_->serverHost);  // rfbGetClient's placeholder
   client_->serverHost = strdup(host.c_str());
   client_->serverPort = port;
   client_->appData.encodingsString = "tight copyrect";

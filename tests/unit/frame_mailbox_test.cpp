@@ -57,10 +57,14 @@ TEST_CASE("a reader never sees a torn frame") {
   std::vector<std::uint8_t> out;
   int taken = 0;
   bool torn = false;
-  while (!done || mailbox.take(out)) {
+  // Keep reading until the writer is done and its last frame has been taken.
+  for (;;) {
+    const bool finished = done;
     if (mailbox.take(out)) {
       ++taken;
       for (auto byte : out) torn = torn || byte != out[0];
+    } else if (finished) {
+      break;
     }
   }
   writer.join();

@@ -42,6 +42,7 @@ TEST_CASE("sniffing tells RFB - WebSocket and HTTP apart") {
   CHECK(sniff_protocol("GET / HTTP/1.1\r\nHost: x\r\n") == WireProtocol::Undecided);
   CHECK(sniff_protocol("GET / HTTP/1.1\r\nHost: x\r\n\r\n") == WireProtocol::Http);
   CHECK(sniff_protocol("HEAD / HTTP/1.1\r\n\r\n") == WireProtocol::Http);
+  CHECK(sniff_protocol("POST / HTTP/1.1\r\n\r\n") == WireProtocol::Http);  // answered with 405
   CHECK(sniff_protocol("GET /websockify HTTP/1.1\r\nUpgrade: WebSocket\r\nConnection: Upgrade\r\n\r\n") ==
         WireProtocol::WebSocket);
   CHECK(sniff_protocol("GET junk\r\n\r\n") == WireProtocol::Http);  // answered with 400

@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// A real WebSocket client (websocketpp) reaches rfbsim::Server's shared port the way noVNC does:
+// HTTP upgrade to ws://HOST:PORT/websockify, then the whole RFB handshake and a first update over
+// binary messages, while plain HTTP keeps working on the same port.
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "rfb_test_client.hpp"
+#include "rfb_wire.hpp"
+#include "rfbsim/server.hpp"
+#include "ws_test_client.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+using rfbsim::test::WsTestClient;
+
+constexpr int kWidth = 64;
+constexpr int kHeight = 48;
+
+// A small gradient so that every pixel's value is known exactly.
+std::vector<std::uint8_t> gradient_frame() {
+  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(kWidth) * kHeight * 4U);
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      std::uint8_t* p = &pixels[(static_cast<std::size_t>(y) * kWidth + static_cast<std::size_t>(x)) * 4U];
+      p[0] = static_cast<std::uint8_t>(x * 4);
+      p[1] = static_cast<std::uint8_t>(y * 5);
+      p[2] = static_cast<std::uint8_t>(200 - x - y);
+      p[3] = 255;
+    }
+  }
+  return pixels;
+}
+
+}  // namespace
+
+TEST_CASE("websocketpp client completes the RFB handshake over WebSocket and gets an update",
+          "[robustness][websocket]") {
+  // Record what the connect callback sees; it runs on the server's network thread.
+  std::mutex seen_mutex;
+  std::vector<rfbsim::ClientInfo> seen;
+  rfbsim::ServerOptions options;
+  options.width = kWidth;
+  options.height = kHeight;
+  options.desktop_name = "ws-handshake-test";
+  options.json_routes["/ping.json"] = [] { return std::string(R"({"pong":42})"); };
+  options.on_connect = [&](const rfbsim::ClientInfo& info) {
+    std::lock_guard lock(seen_mutex);
+    seen.push_back(info);
+  };
+  rfbsim::Server server(options);
+  const auto frame = gradient_frame();
+  server.submit(rfbsim::FrameView{frame.data(), kWidth, kHeight, 0});
+
+  // The opening handshake must carry Origin (libvncserver refuses it otherwise).
+  WsTestClient ws(server.port(), "/websockify", "http://127.0.0.1:" + std::to_string(server.port()), "binary");
+  CHECK(ws.subprotocol() == "binary");
+  const rfbsim::test::ReadExact read = [&ws](std::size_t n, std::vector<std::uint8_t>& out) {
+    return ws.read_exact(n, out, 5s);
+  };
+  const rfbsim::test::WriteAll write = [&ws](const std::vector<std::uint8_t>& bytes) { return ws.send_binary(bytes); };
+
+  // RFB handshake over binary messages; ServerInit must describe the server's options.
+  const auto init = rfbsim::test::rfb_client_handshake(read, write);
+  CHECK(init.width == kWidth);
+  CHECK(init.height == kHeight);
+  CHECK(init.name == "ws-handshake-test");
+  CHECK(init.bits_per_pixel == 32);
+  CHECK(init.true_colour);
+
+  // The server counts the client once, as a WebSocket client.
+  {
+    std::lock_guard lock(seen_mutex);
+    REQUIRE(seen.size() == 1);
+    CHECK(seen[0].websocket);
+    CHECK(seen[0].address == "127.0.0.1");
+    CHECK(seen[0].id >= 1);
+  }
+  CHECK(server.client_count() == 1);
+  CHECK(server.stats().clients == 1);
+
+  // Plain HTTP on the same port answers while the WebSocket client is connected.
+  const std::string response = rfbsim::test::http_get(server.port(), "/ping.json");
+  CHECK(response.rfind("HTTP/1.1 200", 0) == 0);
+  CHECK(rfbsim::test::http_body(response) == R"({"pong":42})");
+
+  // Ask for Raw pixels of the whole frame: the update must carry exactly the submitted picture.
+  REQUIRE(write(rfbsim::test::rfb_set_encodings({0})));
+  REQUIRE(write(rfbsim::test::rfb_update_request(false, 0, 0, kWidth, kHeight)));
+  const auto rects = rfbsim::test::rfb_read_raw_update(read, init.bits_per_pixel / 8);
+  REQUIRE_FALSE(rects.empty());
+  long covered = 0;
+  int wrong_pixels = 0;
+  for (const auto& rect : rects) {
+    covered += static_cast<long>(rect.w) * rect.h;
+    for (int y = 0; y < rect.h; ++y) {
+      for (int x = 0; x < rect.w; ++x) {
+        // The server's pixel format keeps red in the lowest byte: Raw bytes are R, G, B, X.
+        const std::uint8_t* got = &rect.pixels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(rect.w) +
+                                                static_cast<std::size_t>(x)) * 4U];
+        const std::uint8_t* want = &frame[(static_cast<std::size_t>(rect.y + y) * kWidth +
+                                           static_cast<std::size_t>(rect.x + x)) * 4U];
+        if (got[0] != want[0] || got[1] != want[1] || got[2] != want[2]) ++wrong_pixels;
+      }
+    }
+  }
+  CHECK(covered == static_cast<long>(kWidth) * kHeight);
+  CHECK(wrong_pixels == 0);
+  CHECK(ws.text_messages() == 0);
+  CHECK(server.stats().updates_sent >= 1);
+
+  // HTTP still answers after the update, and a close is noticed by the server.
+  CHECK(rfbsim::test::http_body(rfbsim::test::http_get(server.port(), "/ping.json")) == R"({"pong":42})");
+  ws.close();
+  const auto deadline = std::chrono::steady_clock::now() + 5s;
+  while (server.client_count() != 0 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(10ms);  // the network thread notices the close on its next poll
+  }
+  CHECK(server.client_count() == 0);
+}
