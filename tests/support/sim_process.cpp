@@ -24,8 +24,15 @@ std::string sim_rfb_path() {
 #endif
 }
 
-ExitResult run_to_exit(const std::string& program, const std::vector<std::string>& args,
-                       std::chrono::milliseconds timeout) {
+namespace {
+
+// A child running `program` with `args` (no shell); its stdout, and stderr too when asked, go to a pipe.
+struct Spawned {
+  pid_t pid = -1;
+  int output_fd = -1;  // the pipe's read end, owned by the caller
+};
+
+Spawned spawn(const std::string& program, const std::vector<std::string>& args, bool with_stderr) {
   int pipe_fds[2];
   if (::pipe2(pipe_fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
   std::vector<std::string> argv_strings{program};
@@ -37,27 +44,37 @@ ExitResult run_to_exit(const std::string& program, const std::vector<std::string
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
     ::dup2(pipe_fds[1], STDOUT_FILENO);
-    ::dup2(pipe_fds[1], STDERR_FILENO);
+    if (with_stderr) ::dup2(pipe_fds[1], STDERR_FILENO);
     ::execv(program.c_str(), argv.data());
     _exit(127);
   }
   ::close(pipe_fds[1]);
+  return {pid, pipe_fds[0]};
+}
+
+}  // namespace
+
+ExitResult run_to_exit(const std::string& program, const std::vector<std::string>& args,
+                       std::chrono::milliseconds timeout) {
+  const Spawned child = spawn(program, args, true);
+  const pid_t pid = child.pid;
+  const int output_fd = child.output_fd;
   ExitResult result;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   // Read until end of file (the child exited and closed its end) or the deadline.
   for (;;) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    pollfd pfd{pipe_fds[0], POLLIN, 0};
+    pollfd pfd{output_fd, POLLIN, 0};
     if (left.count() <= 0 || ::poll(&pfd, 1, static_cast<int>(left.count())) <= 0) {
       ::kill(pid, SIGKILL);
       break;
     }
     char buffer[512];
-    const auto n = ::read(pipe_fds[0], buffer, sizeof buffer);
+    const auto n = ::read(output_fd, buffer, sizeof buffer);
     if (n <= 0) break;
     result.output.append(buffer, static_cast<std::size_t>(n));
   }
-  ::close(pipe_fds[0]);
+  ::close(output_fd);
   int status = 0;
   ::waitpid(pid, &status, 0);
   result.status = std::chrono::steady_clock::now() < deadline ? status : -1;
@@ -66,23 +83,9 @@ ExitResult run_to_exit(const std::string& program, const std::vector<std::string
 
 SimProcess::SimProcess(const std::string& program, const std::vector<std::string>& args,
                        std::chrono::milliseconds timeout) {
-  int pipe_fds[2];
-  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
-  std::vector<std::string> argv_strings{program};
-  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& s : argv_strings) argv.push_back(s.data());
-  argv.push_back(nullptr);
-
-  pid_ = ::fork();
-  if (pid_ < 0) throw std::runtime_error("fork failed");
-  if (pid_ == 0) {
-    ::dup2(pipe_fds[1], STDOUT_FILENO);
-    ::execv(program.c_str(), argv.data());
-    _exit(127);
-  }
-  ::close(pipe_fds[1]);
-  stdout_fd_ = pipe_fds[0];
+  const Spawned child = spawn(program, args, false);
+  pid_ = child.pid;
+  stdout_fd_ = child.output_fd;
 
   // Read stdout until the ready line names the URL.
   std::string output;
