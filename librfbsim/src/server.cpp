@@ -13,18 +13,25 @@
 #include <netinet/tcp.h>
 #include <poll.h>
 #include <rfb/rfb.h>
+#include <linux/sockios.h>
 #include <sys/eventfd.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdarg>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
+#include "call_watchdog.hpp"
 #include "frame_mailbox.hpp"
 #include "held_keys.hpp"
 #include "http_request.hpp"
@@ -43,6 +50,15 @@ using Clock = std::chrono::steady_clock;
 constexpr auto kSniffTimeout = std::chrono::milliseconds(500);
 // Poll timeout when nothing is pending; only bounds how fast the thread notices a stop request.
 constexpr int kIdlePollMs = 200;
+// Poll timeout while a client's output is backed up: how often we look whether it has drained.
+constexpr int kBackedUpPollMs = 5;
+// Flow control: no new update is started for a client while more than this many bytes of earlier ones
+// are still unsent in its socket. A client on a slow link then gets fewer, always current, frames instead
+// of a growing backlog, and writing its updates never blocks the thread that serves everyone.
+constexpr int kMaxUnsentBytes = 128 * 1024;
+// Asked-for socket send buffer (the kernel caps it at twice net.core.wmem_max): room for one whole update
+// on top of kMaxUnsentBytes, so that starting an update does not block either.
+constexpr int kSendBufferBytes = 1024 * 1024;
 
 // libvncserver's log goes through these global hooks; keep its chatter off unless asked for.
 bool vnc_log_enabled() {
@@ -59,6 +75,13 @@ void vnc_log(const char* format, ...) {
 }
 
 // libvncserver's index of Tight subsampling levels: 0 = 4:4:4, 1 = 4:2:0, 2 = 4:2:2, 3 = grey.
+// Bytes written to a socket that the peer has not yet acknowledged (TCP) or read.
+int unsent_bytes(int fd) {
+  int queued = 0;
+  if (::ioctl(fd, SIOCOUTQ, &queued) != 0) return 0;
+  return queued;
+}
+
 int turbo_subsampling_index(Subsampling s) {
   switch (s) {
     case Subsampling::k444: return 0;
@@ -89,6 +112,9 @@ ServerOptions validated(ServerOptions o) {
   }
   if (o.jpeg_quality < 0 || o.jpeg_quality > 100) throw std::runtime_error("jpeg_quality must be 0..100");
   if (o.max_clients < 1) throw std::runtime_error("max_clients must be at least 1");
+  if (o.read_timeout.count() < 1 || o.write_timeout.count() < 1) {
+    throw std::runtime_error("read_timeout and write_timeout must be at least 1 ms");
+  }
   if (!o.web_root.empty() && !std::filesystem::is_regular_file(std::filesystem::path(o.web_root) / "index.html")) {
     throw std::runtime_error("web root '" + o.web_root + "' has no index.html");
   }
@@ -105,6 +131,8 @@ ServerOptions validated(ServerOptions o) {
 // Per-client bookkeeping, owned through rfbClientRec::clientData.
 struct ClientState {
   ClientInfo info;
+  int guard_fd = -1;  // our dup of the client's socket, for the watchdog (libvncserver may close its own)
+  std::optional<Clock::time_point> backed_up_since;  // output above kMaxUnsentBytes since then
   Clock::time_point update_started{};
   int bytes_before_update = 0;
 };
@@ -124,6 +152,8 @@ struct Server::Impl {
   void classify_pending();
   void adopt_rfb(int fd);
   void apply_newest_frame();
+  void serve_clients(const std::vector<pollfd>& polled);
+  bool may_send_update(rfbClientPtr cl, Clock::time_point now);
   int poll_timeout_ms() const;
 
   // libvncserver hooks (C function pointers); `self` comes from screen->screenData.
@@ -147,6 +177,9 @@ struct Server::Impl {
   detail::HeldKeys held_keys;             // network thread only
   std::vector<PendingConnection> pending; // network thread only
   std::unique_ptr<detail::HttpService> http;
+  detail::CallWatchdog watchdog;          // cuts off a client that blocks the network thread
+  int adopting_guard_fd = -1;             // handed from adopt_rfb to on_new_client
+  bool any_backed_up = false;             // some client's output is above kMaxUnsentBytes
   int next_client_id = 1;
 
   std::atomic<bool> stopping{false};
@@ -157,6 +190,7 @@ struct Server::Impl {
   std::atomic<std::uint64_t> updates_sent{0};
   std::atomic<std::uint64_t> bytes_sent{0};
   std::atomic<std::uint64_t> encode_ns{0};
+  std::atomic<std::uint64_t> backed_up_drops{0};
   std::thread thread;
 };
 
@@ -207,7 +241,8 @@ Server::Impl::Impl(ServerOptions o)
   screen->httpDir = nullptr;
   screen->alwaysShared = TRUE;  // several viewers of one session (participant + researcher) coexist
   screen->deferUpdateTime = 0;  // frames already arrive in whole batches
-  screen->maxClientWait = static_cast<int>(options.write_timeout.count());
+  // libvncserver waits this long for each next byte of a message (the watchdog bounds the whole message).
+  screen->maxClientWait = static_cast<int>(options.read_timeout.count());
   screen->newClientHook = on_new_client;
   screen->kbdAddEvent = on_key;
   screen->ptrAddEvent = on_pointer;
@@ -239,11 +274,12 @@ Server::Impl::~Impl() {
 }
 
 int Server::Impl::poll_timeout_ms() const {
-  if (pending.empty()) return kIdlePollMs;
+  const int idle = any_backed_up ? kBackedUpPollMs : kIdlePollMs;
+  if (pending.empty()) return idle;
   auto earliest = pending.front().accepted;
   for (const auto& connection : pending) earliest = std::min(earliest, connection.accepted);
   const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(earliest + kSniffTimeout - Clock::now());
-  return static_cast<int>(std::max<std::int64_t>(1, left.count() + 1));
+  return static_cast<int>(std::clamp<std::int64_t>(left.count() + 1, 1, idle));
 }
 
 void Server::Impl::run() {
@@ -267,9 +303,68 @@ void Server::Impl::run() {
     accept_new();
     classify_pending();
     apply_newest_frame();
-    // Reads client messages (input, update requests) and sends pending updates; never blocks on reads.
-    rfbProcessEvents(screen, 0);
+    serve_clients(fds);
   }
+}
+
+// Does what rfbProcessEvents does for our kind of server (no listening socket of libvncserver's, no
+// file transfer), but one client at a time under the watchdog, and with flow control on updates.
+void Server::Impl::serve_clients(const std::vector<pollfd>& polled) {
+  // 1. Read what the clients sent: input, update requests, handshake steps.
+  for (rfbClientPtr cl = screen->clientHead; cl != nullptr; cl = cl->next) {
+    if (cl->sock == RFB_INVALID_SOCKET) continue;
+    const auto* state = static_cast<ClientState*>(cl->clientData);
+    const auto it = std::find_if(polled.begin(), polled.end(), [&](const pollfd& p) { return p.fd == cl->sock; });
+    if (state == nullptr || it == polled.end() || (it->revents & (POLLIN | POLLHUP | POLLERR)) == 0) continue;
+    watchdog.arm(state->guard_fd, Clock::now() + options.read_timeout);
+    rfbProcessClientMessage(cl);
+    // A WebSocket frame can carry several RFB messages; what libvncserver already decoded is not
+    // visible to poll, so keep reading while its buffer holds some.
+    while (cl->sock != RFB_INVALID_SOCKET && cl->wsctx != nullptr && webSocketsHasDataInBuffer(cl)) {
+      watchdog.arm(state->guard_fd, Clock::now() + options.read_timeout);
+      rfbProcessClientMessage(cl);
+    }
+    watchdog.disarm();
+  }
+
+  // 2. Send updates to the clients that asked for one and can take it.
+  const auto now = Clock::now();
+  any_backed_up = false;
+  for (rfbClientPtr cl = screen->clientHead; cl != nullptr; cl = cl->next) {
+    if (cl->sock == RFB_INVALID_SOCKET || !may_send_update(cl, now)) continue;
+    const auto* state = static_cast<ClientState*>(cl->clientData);
+    watchdog.arm(state->guard_fd, now + options.write_timeout);
+    rfbUpdateClient(cl);
+    watchdog.disarm();
+  }
+
+  // 3. Forget the clients that left or were dropped above (this runs on_client_gone).
+  for (rfbClientPtr cl = screen->clientHead; cl != nullptr;) {
+    rfbClientPtr next = cl->next;
+    if (cl->sock == RFB_INVALID_SOCKET) rfbClientConnectionGone(cl);
+    cl = next;
+  }
+}
+
+// Flow control for one client: false while its earlier output is still backed up; drops the client
+// when it stays backed up for write_timeout.
+bool Server::Impl::may_send_update(rfbClientPtr cl, Clock::time_point now) {
+  auto* state = static_cast<ClientState*>(cl->clientData);
+  if (state == nullptr) return false;
+  if (unsent_bytes(cl->sock) <= kMaxUnsentBytes) {
+    state->backed_up_since.reset();
+    return true;
+  }
+  if (!state->backed_up_since) state->backed_up_since = now;
+  if (now - *state->backed_up_since >= options.write_timeout) {
+    std::fprintf(stderr, "[rfbsim.server] dropping client %d (%s): it read nothing for %lld ms\n", state->info.id,
+                 state->info.address.c_str(), static_cast<long long>(options.write_timeout.count()));
+    ++backed_up_drops;
+    rfbCloseClient(cl);
+    return false;
+  }
+  any_backed_up = true;
+  return false;
 }
 
 void Server::Impl::accept_new() {
@@ -315,9 +410,22 @@ void Server::Impl::classify_pending() {
 void Server::Impl::adopt_rfb(int fd) {
   const int one = 1;
   ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-  // libvncserver takes the socket over: it runs the WebSocket handshake if there is one, then RFB.
-  // On failure it closes the socket itself.
+  ::setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &kSendBufferBytes, sizeof kSendBufferBytes);
+  // libvncserver takes the socket over: it runs the WebSocket handshake if there is one (under the
+  // watchdog, so a handshake sent byte by byte cannot hold the thread), then RFB. On failure it closes
+  // the socket itself; our duplicate keeps the watchdog's descriptor valid meanwhile.
+  const int guard = ::fcntl(fd, F_DUPFD_CLOEXEC, 0);
+  if (guard < 0) {
+    std::fprintf(stderr, "[rfbsim.server] refusing a client: out of file descriptors\n");
+    ::close(fd);
+    return;
+  }
+  adopting_guard_fd = guard;
+  watchdog.arm(guard, Clock::now() + options.read_timeout);
   rfbNewClient(screen, fd);
+  watchdog.disarm();
+  // on_new_client takes the duplicate when it accepts the client; otherwise it is ours to close.
+  if (adopting_guard_fd >= 0) ::close(std::exchange(adopting_guard_fd, -1));
 }
 
 void Server::Impl::apply_newest_frame() {
@@ -342,6 +450,8 @@ void Server::Impl::apply_newest_frame() {
 
 rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
   Impl& self = of(cl);
+  // Set before refusing too: refused clients also pass through the hook (see on_client_gone).
+  cl->clientGoneHook = on_client_gone;
   if (self.clients.load() >= self.options.max_clients) {
     std::fprintf(stderr, "[rfbsim.server] refusing a client: %d of %d already connected\n", self.clients.load(),
                  self.options.max_clients);
@@ -351,8 +461,8 @@ rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
   state->info.id = self.next_client_id++;
   state->info.address = peer_address(cl->sock);
   state->info.websocket = cl->wsctx != nullptr;
+  state->guard_fd = std::exchange(self.adopting_guard_fd, -1);
   cl->clientData = state;
-  cl->clientGoneHook = on_client_gone;
   cl->viewOnly = self.options.view_only ? TRUE : FALSE;
   ++self.clients;
   if (self.options.on_connect) self.options.on_connect(state->info);
@@ -361,9 +471,17 @@ rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
 
 void Server::Impl::on_client_gone(rfbClientPtr cl) {
   Impl& self = of(cl);
+#if RFBSIM_LIBVNCSERVER_LEAKS_WSCTX
+  // libvncserver up to 0.9.14 never frees a WebSocket client's context (about 46 KB a connection;
+  // LibVNC/libvncserver#571, fixed after 0.9.14). Nothing reads it after this hook.
+  std::free(cl->wsctx);
+  cl->wsctx = nullptr;
+#endif
   auto* state = static_cast<ClientState*>(cl->clientData);
   if (state == nullptr) return;
   cl->clientData = nullptr;
+  self.watchdog.forget(state->guard_fd);
+  ::close(state->guard_fd);
   const int remaining = --self.clients;
   // Keys this client held would otherwise stay down forever in the simulation.
   const auto now = Clock::now();
@@ -471,6 +589,7 @@ ServerStats Server::stats() const {
   s.encode_ms = static_cast<double>(impl_->encode_ns.load()) / 1e6;
   s.http_requests = impl_->http->requests();
   s.clients = impl_->clients.load();
+  s.stalled_clients_dropped = impl_->watchdog.fired() + impl_->backed_up_drops.load();
   return s;
 }
 

@@ -87,7 +87,7 @@ TEST_CASE("garbage instead of the RFB version closes only that connection", "[ro
 
 TEST_CASE("a truncated RFB handshake is forgotten", "[robustness][rfb]") {
   rfbsim::ServerOptions options = small_server();
-  options.write_timeout = 1000ms;  // also bounds how long a half-sent message may keep the server waiting
+  options.read_timeout = 1000ms;  // bounds how long a half-sent message may keep the server waiting
   ServedScene scene(options);
   SECTION("half a version at once, then close") {
     RawSocket socket(scene.port());
@@ -149,7 +149,7 @@ TEST_CASE("an oversized ClientCutText after a hand-made handshake closes only th
 
 TEST_CASE("bad WebSocket frames close only that connection", "[robustness][websocket]") {
   rfbsim::ServerOptions options = small_server();
-  options.write_timeout = 1000ms;
+  options.read_timeout = 1000ms;
   ServedScene scene(options);
   RawSocket socket(scene.port());
   const std::string head = rfbsim::test::raw_websocket_upgrade(socket, scene.port());

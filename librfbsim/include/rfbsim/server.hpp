@@ -44,6 +44,7 @@ struct ServerStats {
   double encode_ms = 0.0;              ///< milliseconds spent encoding and sending updates
   std::uint64_t http_requests = 0;     ///< plain HTTP requests answered (page, files, json)
   int clients = 0;                     ///< RFB clients connected now
+  std::uint64_t stalled_clients_dropped = 0;  ///< clients cut off by read_timeout or write_timeout
 };
 
 /// Definition of a server; start from the defaults and change what you need.
@@ -58,7 +59,12 @@ struct ServerOptions {
   bool view_only = false;                    ///< ignore every key and pointer event
   std::string desktop_name = "rfbsim";       ///< the name RFB clients show
   std::string web_root;                      ///< directory served to plain HTTP GETs; empty = none
-  std::chrono::milliseconds write_timeout{5000};  ///< a client that accepts no bytes this long is dropped
+  /// A client that takes longer than this to send one whole message (input, update request, handshake
+  /// step) is dropped: the one network thread waits for it meanwhile.
+  std::chrono::milliseconds read_timeout{1000};
+  /// A client whose earlier updates stay unsent this long (it stopped reading) is dropped; until then it
+  /// gets no new updates and others are served as usual.
+  std::chrono::milliseconds write_timeout{5000};
   std::function<void(const ClientInfo&)> on_connect;     ///< network thread; may be empty
   std::function<void(const ClientInfo&)> on_disconnect;  ///< network thread; may be empty
   /// Extra JSON endpoints on the same port, e.g. {"/status.json", fn}; fn runs on an HTTP worker thread
