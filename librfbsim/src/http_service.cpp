@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// HttpService: read one request head, answer it, close.
+// HttpService: read one request head, answer it, close; a bounded pool of workers, a bounded wait list.
 #include "http_service.hpp"
 
 #include <poll.h>
@@ -63,6 +63,8 @@ HttpService::~HttpService() {
     for (auto& worker : workers_) {
       if (worker->fd >= 0) ::shutdown(worker->fd, SHUT_RDWR);
     }
+    for (const int fd : waiting_) ::close(fd);
+    waiting_.clear();
     workers.swap(workers_);
   }
   for (auto& worker : workers) worker->thread.join();
@@ -82,21 +84,40 @@ void HttpService::reap_finished_locked() {
 void HttpService::serve(int fd) {
   std::lock_guard lock(mutex_);
   reap_finished_locked();
-  if (stopping_ || static_cast<int>(workers_.size()) >= config_.max_workers) {
-    const std::string body = error_body(503, "too many requests at once, try again");
-    send_all(fd, response_head(503, "text/plain; charset=utf-8", body.size()) + body, 100);
-    ::close(fd);
+  if (!stopping_ && static_cast<int>(workers_.size()) < config_.max_workers) {
+    auto worker = std::make_unique<Worker>();
+    worker->fd = fd;
+    Worker& ref = *worker;
+    workers_.push_back(std::move(worker));
+    ref.thread = std::thread([this, &ref] { run(ref); });
     return;
   }
-  auto worker = std::make_unique<Worker>();
-  worker->fd = fd;
-  Worker& ref = *worker;
-  workers_.push_back(std::move(worker));
-  ref.thread = std::thread([this, &ref] { run(ref); });
+  // A browser loading the page's modules opens connections in bursts; a busy or slow host (a sanitizer
+  // build, a loaded server) must make them wait, not fail the page.
+  if (!stopping_ && static_cast<int>(waiting_.size()) < config_.max_waiting) {
+    waiting_.push_back(fd);
+    return;
+  }
+  const std::string body = error_body(503, "too many requests at once, try again");
+  send_all(fd, response_head(503, "text/plain; charset=utf-8", body.size()) + body, 100);
+  ::close(fd);
 }
 
 void HttpService::run(Worker& worker) {
-  const int fd = worker.fd;
+  for (;;) {
+    serve_one(worker.fd);
+    // Closed under the lock so that the destructor never shuts down a descriptor number already reused.
+    std::lock_guard lock(mutex_);
+    ::close(worker.fd);
+    worker.fd = -1;
+    if (stopping_ || waiting_.empty()) break;
+    worker.fd = waiting_.front();
+    waiting_.pop_front();
+  }
+  worker.done = true;
+}
+
+void HttpService::serve_one(int fd) {
   std::string received;
   int status = 0;  // 0 = parsed; otherwise the error status to answer
   HttpParseResult parsed;
@@ -125,19 +146,11 @@ void HttpService::run(Worker& worker) {
     }
     if (n > 0) received.append(buffer, static_cast<std::size_t>(n));
   }
-  if (status >= 0) {
-    if (parsed.status == HttpParseResult::Status::Invalid) {
-      std::fprintf(stderr, "[rfbsim.http] bad request: %s\n", parsed.error.c_str());
-    }
-    respond(fd, status == 0 ? &parsed.request : nullptr, status);
+  if (status < 0) return;
+  if (parsed.status == HttpParseResult::Status::Invalid) {
+    std::fprintf(stderr, "[rfbsim.http] bad request: %s\n", parsed.error.c_str());
   }
-  {
-    // Closed under the lock so that the destructor never shuts down a descriptor number already reused.
-    std::lock_guard lock(mutex_);
-    ::close(fd);
-    worker.fd = -1;
-  }
-  worker.done = true;
+  respond(fd, status == 0 ? &parsed.request : nullptr, status);
 }
 
 void HttpService::respond(int fd, const HttpRequest* request, int parse_status) {

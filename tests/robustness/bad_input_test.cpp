@@ -10,6 +10,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <thread>
+#include <vector>
 
 #include "misbehaving_clients.hpp"
 #include "rfb_test_client.hpp"
@@ -310,4 +313,23 @@ TEST_CASE("malformed HTTP gets the right status and leaves RFB alone", "[robustn
     scene.check_still_serving();
   }
   std::filesystem::remove_all(root);
+}
+
+TEST_CASE("HTTP connections beyond the worker pool wait for a worker instead of failing", "[robustness][http]") {
+  rfbsim::ServerOptions options = small_server();
+  options.json_routes["/status.json"] = [] { return std::string(R"({"ok":1})"); };
+  ServedScene scene(options);
+  const int port = scene.port();
+  // More silent request heads than there are workers (16): each holds a worker until the HTTP timeout.
+  std::vector<std::unique_ptr<RawSocket>> silent;
+  for (int i = 0; i < 20; ++i) {
+    silent.push_back(std::make_unique<RawSocket>(port));
+    REQUIRE(silent.back()->send_all(std::string_view("G")));
+  }
+  std::this_thread::sleep_for(700ms);  // past the sniffing, so that all of them reach the HTTP workers
+  // A browser's request arriving now waits for a free worker and is then answered, not refused with 503.
+  const std::string answer = http_exchange(port, "GET /status.json HTTP/1.1\r\nHost: x\r\n\r\n");
+  CHECK(status_line(answer) == "HTTP/1.1 200 OK");
+  CHECK(rfbsim::test::http_body(answer) == R"({"ok":1})");
+  scene.check_still_serving();
 }
