@@ -76,20 +76,28 @@ Scene build_scene(const World& world, const SceneStyle& style) {
   const auto res = static_cast<float>(map.resolution);
   const auto map_w = static_cast<float>(map.width) * res;
   const auto map_h = static_cast<float>(map.height) * res;
-  const Eigen::Vector3f map_centre{static_cast<float>(map.origin_x) + map_w / 2.0f,
-                                   static_cast<float>(map.origin_y) + map_h / 2.0f, 0.0f};
+  const Eigen::Vector2d centre = map.to_world({static_cast<double>(map_w) / 2.0, static_cast<double>(map_h) / 2.0});
+  const Eigen::AngleAxisf map_turn(static_cast<float>(map.origin_yaw), Eigen::Vector3f::UnitZ());
 
   // Floor: a thin slab under the whole map.
-  scene.items.push_back(box(map_centre - Eigen::Vector3f(0.0f, 0.0f, 0.05f), {map_w, map_h, 0.1f},
-                            rgb(0xc8c2b4), Surface::Floor));
+  DrawItem floor = box({static_cast<float>(centre.x()), static_cast<float>(centre.y()), -0.05f}, {map_w, map_h, 0.1f},
+                       rgb(0xc8c2b4), Surface::Floor);
+  floor.model = Eigen::Translation3f(static_cast<float>(centre.x()), static_cast<float>(centre.y()), -0.05f) *
+                map_turn * Eigen::Scaling(map_w, map_h, 0.1f);
+  scene.items.push_back(floor);
 
-  // Walls: one box per merged run of wall cells.
-  for (const WallRun& run : merge_wall_runs(map)) {
-    const float x0 = static_cast<float>(map.origin_x) + static_cast<float>(run.first_column) * res;
-    const float y0 = static_cast<float>(map.origin_y) + static_cast<float>(run.row) * res;
-    const float w = static_cast<float>(run.columns) * res;
-    scene.items.push_back(box({x0 + w / 2.0f, y0 + res / 2.0f, style.wall_height / 2.0f}, {w, res, style.wall_height},
-                              rgb(0xe6e1d6), Surface::Wall));
+  // Walls: one box per merged rectangle of wall cells.
+  for (const WallRect& rect : merge_wall_rectangles(map)) {
+    const float w = static_cast<float>(rect.columns) * res;
+    const float h = static_cast<float>(rect.rows) * res;
+    const Eigen::Vector2d at = map.to_world({static_cast<double>(rect.first_column) * map.resolution + static_cast<double>(w) / 2.0,
+                                             static_cast<double>(rect.first_row) * map.resolution + static_cast<double>(h) / 2.0});
+    DrawItem wall;
+    wall.surface = Surface::Wall;
+    wall.color = rgb(0xe6e1d6);
+    wall.model = Eigen::Translation3f(static_cast<float>(at.x()), static_cast<float>(at.y()), style.wall_height / 2.0f) *
+                 map_turn * Eigen::Scaling(w, h, style.wall_height);
+    scene.items.push_back(wall);
   }
 
   for (const Prop& prop : world.props) {
