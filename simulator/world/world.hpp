@@ -3,7 +3,10 @@
 // and the status reporter only read it. No GL, EGL or network types here.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "map/grid_map.hpp"
@@ -17,14 +20,66 @@ struct Pose2 {
   double yaw = 0.0;
 };
 
-/// An axis-aligned box standing on the floor (crates, obstacles).
+/// What a prop is, for drawing it; every kind blocks walking and the grid as its whole box.
+enum class PropKind {
+  Box,    ///< a crate
+  Shelf,  ///< warehouse shelving: uprights and boards with goods
+  Desk,   ///< a desk with a monitor
+};
+
+/// A box standing on the floor (crates, shelving, desks), turned by yaw about its centre.
 struct Prop {
   double x = 0.0;       ///< centre, m
   double y = 0.0;       ///< centre, m
-  double size_x = 0.5;  ///< full extent along x, m
-  double size_y = 0.5;  ///< full extent along y, m
+  double size_x = 0.5;  ///< full extent along its own x (yaw 0: world x), m
+  double size_y = 0.5;  ///< full extent along its own y, m
   double height = 0.5;  ///< m
   std::uint32_t rgb = 0xb08850;  ///< colour 0xRRGGBB
+  double yaw = 0.0;     ///< rad
+  PropKind kind = PropKind::Box;
+};
+
+/// A visible marker on the floor, e.g. the participant's goal.
+struct Landmark {
+  std::string name;
+  double x = 0.0;
+  double y = 0.0;
+  double radius = 0.3;  ///< m
+  std::uint32_t rgb = 0xf2c12e;
+};
+
+/// A simulated pedestrian: what the crowd, the physics and the renderer share.
+struct Person {
+  int id = 0;                  ///< 1, 2, ... in scenario order
+  Pose2 pose;                  ///< yaw: the way the body faces
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< m/s, as moved last tick
+  double desired_speed = 1.34; ///< m/s, drawn per person
+  double radius = 0.25;        ///< m, body radius for contacts
+  double height = 1.75;        ///< m
+  std::uint32_t rgb = 0x8a5a9e;  ///< shirt colour
+  double gait_phase = 0.0;     ///< radians of the walking cycle
+};
+
+/// The robot's physical state (its navigation stack comes with the robot issue).
+struct Robot {
+  Pose2 pose;
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< m/s, world frame
+  double yaw_rate = 0.0;   ///< rad/s
+  double radius = 0.16;    ///< m, Kuri's footprint
+  double height = 0.5;     ///< m
+};
+
+/// Who took part in a contact.
+enum class Party { Avatar, Person, Robot, Static };
+
+/// Two bodies touched during a tick; `impulse` (N s) is how hard, summed over the tick's contact points.
+struct ContactEvent {
+  std::uint64_t tick = 0;
+  Party a = Party::Avatar;
+  int a_index = 0;  ///< index into people for Party::Person; 0 otherwise
+  Party b = Party::Static;
+  int b_index = 0;
+  double impulse = 0.0;
 };
 
 /// The participant's avatar.
@@ -44,12 +99,16 @@ struct CameraRig {
 
 /// Everything that changes while the simulation runs, plus the static map it runs in.
 struct World {
-  GridMap map;
+  GridMap map;  ///< walls and props both block here
   std::vector<Prop> props;
+  std::vector<Landmark> landmarks;
+  std::vector<Person> people;
+  std::optional<Robot> robot;
   Avatar avatar;
   CameraRig camera;
   std::uint64_t tick = 0;  ///< fixed steps taken
   double time = 0.0;       ///< simulated seconds = tick * dt
+  std::vector<ContactEvent> contacts;  ///< contacts that began during the last tick
 };
 
 }  // namespace rfbsim::sim
