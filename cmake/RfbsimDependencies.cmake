@@ -5,6 +5,9 @@ find_package(Threads REQUIRED)
 find_package(LibVNCServer CONFIG REQUIRED)          # LibVNCServer::vncserver, LibVNCServer::vncclient
 find_package(OpenGL REQUIRED COMPONENTS EGL OpenGL)  # OpenGL::EGL, OpenGL::OpenGL (GLVND)
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)          # Eigen3::Eigen
+find_package(yaml-cpp 0.7 REQUIRED CONFIG)           # yaml-cpp (scenario files, map_server YAML)
+pkg_check_modules(ODE REQUIRED IMPORTED_TARGET ode)  # PkgConfig::ODE (ODE has no CMake config)
+pkg_check_modules(PNG REQUIRED IMPORTED_TARGET libpng)  # PkgConfig::PNG (map images)
 if(RFBSIM_BUILD_TESTS OR RFBSIM_BUILD_BENCH)
   find_package(websocketpp CONFIG REQUIRED)          # websocketpp::websocketpp (header-only)
   find_package(Boost REQUIRED COMPONENTS system)     # websocketpp's asio transport
