@@ -99,7 +99,8 @@ struct CameraRig {
 
 /// Everything that changes while the simulation runs, plus the static map it runs in.
 struct World {
-  GridMap map;  ///< walls and props both block here
+  GridMap map;        ///< the map file's walls only (drawn as walls, built as static physics boxes)
+  GridMap obstacles;  ///< map with every prop blocked too: what route planning and wall forces use
   std::vector<Prop> props;
   std::vector<Landmark> landmarks;
   std::vector<Person> people;
