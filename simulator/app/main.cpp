@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -20,6 +21,7 @@
 #include "render/scene_builder.hpp"
 #include "rfbsim/offscreen_gl.hpp"
 #include "rfbsim/server.hpp"
+#include "scenario/scenario.hpp"
 #include "world/demo_world.hpp"
 #include "world/fixed_step_clock.hpp"
 
@@ -65,9 +67,36 @@ class StatusBoard {
   std::string text_ = "{}";
 };
 
+// The simulation the options ask for: a scenario with its overrides, or the built-in test room.
+std::unique_ptr<rfbsim::sim::Simulation> make_simulation(const rfbsim::sim::SimOptions& options) {
+  namespace sim = rfbsim::sim;
+  sim::SimulationParams params;
+  params.dt = 1.0 / options.tick_hz;
+  if (options.scenario.empty()) {
+    return std::make_unique<sim::Simulation>(params, sim::make_demo_world());
+  }
+  const auto file = sim::find_scenario(options.scenario, {RFBSIM_SOURCE_SCENARIOS, RFBSIM_INSTALLED_SCENARIOS});
+  sim::Scenario scenario = sim::load_scenario(file);
+  sim::ScenarioOverrides overrides;
+  overrides.avatar_start = options.avatar_start;
+  overrides.avatar_goal = options.avatar_goal;
+  overrides.robot_start = options.robot_start;
+  overrides.robot_goal = options.robot_goal;
+  overrides.seed = options.seed;
+  overrides.crowd_count = options.crowd;
+  sim::apply_overrides(scenario, overrides);
+  std::fprintf(stderr, "[sim_rfb] scenario %s (%s), seed %llu, %d people\n", scenario.name.c_str(),
+               file.string().c_str(), static_cast<unsigned long long>(scenario.seed), scenario.crowd.count);
+  return std::make_unique<sim::Simulation>(params, sim::make_world(scenario));
+}
+
 int run(const rfbsim::sim::SimOptions& options) {
   using Clock = std::chrono::steady_clock;
   namespace sim = rfbsim::sim;
+
+  // The scenario first: a broken one ends the program before anything listens.
+  const std::unique_ptr<sim::Simulation> simulation_owner = make_simulation(options);
+  sim::Simulation& simulation = *simulation_owner;
 
   StatusBoard status;
   rfbsim::ServerOptions server_options;
@@ -97,9 +126,6 @@ int run(const rfbsim::sim::SimOptions& options) {
   sim::GlRenderer renderer;
   std::fprintf(stderr, "[sim_rfb] rendering with %s\n", gl.renderer().c_str());
 
-  sim::SimulationParams params;
-  params.dt = 1.0 / options.tick_hz;
-  sim::Simulation simulation(params, sim::make_demo_world());
   sim::FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / options.tick_hz));
   const auto frame_interval = std::chrono::nanoseconds(1'000'000'000LL / options.fps);
   std::uint64_t frames_rendered = 0;
@@ -166,6 +192,9 @@ int main(int argc, char** argv) {
   install_signal_handlers();
   try {
     return run(parsed.options);
+  } catch (const rfbsim::sim::ScenarioError& error) {
+    std::fprintf(stderr, "sim_rfb: scenario error: %s\n", error.what());
+    return 2;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "sim_rfb: error: %s\n", error.what());
     return 1;

@@ -24,13 +24,19 @@ bool parse_number(const std::string& text, T low, T high, T& out) {
 
 std::string sim_usage() {
   return "usage: sim_rfb [--port N] [--bind ADDR] [--width W] [--height H] [--fps F] [--seed S]\n"
+         "               [--scenario NAME|PATH] [--avatar-start P] [--avatar-goal P] [--robot-start P]\n"
+         "               [--robot-goal P] [--crowd N]\n"
          "               [--quality Q] [--max-clients N] [--web-root DIR] [--egl auto|device|surfaceless]\n"
          "  --port N         TCP port for the page, WebSocket and RFB (default 5901; 0 = any free port)\n"
          "  --bind ADDR      numeric address to listen on (default 127.0.0.1)\n"
          "  --width W        frame width in pixels, 160..3840 (default 1280)\n"
          "  --height H       frame height in pixels, 120..2160 (default 720)\n"
          "  --fps F          frames per second while someone watches, 1..120 (default 30)\n"
-         "  --seed S         random seed (default 1)\n"
+         "  --seed S         random seed (default: the scenario's)\n"
+         "  --scenario S     scenario name (warehouse, lab) or YAML file (default: a small test room)\n"
+         "  --avatar-start P, --avatar-goal P, --robot-start P, --robot-goal P\n"
+         "                   a spawn point's name or x,y,yaw in metres and radians\n"
+         "  --crowd N        number of pedestrians, 0..500 (default: the scenario's)\n"
          "  --quality Q      JPEG quality 1..100 (default 80)\n"
          "  --max-clients N  viewers at once, 1..64 (default 4)\n"
          "  --web-root DIR   directory holding the participant page (default: the built page)\n"
@@ -47,7 +53,23 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
       {"--width", [&](const std::string& v) { return parse_number(v, 160, 3840, o.width); }},
       {"--height", [&](const std::string& v) { return parse_number(v, 120, 2160, o.height); }},
       {"--fps", [&](const std::string& v) { return parse_number(v, 1, 120, o.fps); }},
-      {"--seed", [&](const std::string& v) { return parse_number<std::uint64_t>(v, 0, UINT64_MAX, o.seed); }},
+      {"--seed", [&](const std::string& v) {
+         std::uint64_t seed = 0;
+         if (!parse_number<std::uint64_t>(v, 0, UINT64_MAX, seed)) return false;
+         o.seed = seed;
+         return true;
+       }},
+      {"--scenario", [&](const std::string& v) { o.scenario = v; return !v.empty(); }},
+      {"--avatar-start", [&](const std::string& v) { o.avatar_start = v; return !v.empty(); }},
+      {"--avatar-goal", [&](const std::string& v) { o.avatar_goal = v; return !v.empty(); }},
+      {"--robot-start", [&](const std::string& v) { o.robot_start = v; return !v.empty(); }},
+      {"--robot-goal", [&](const std::string& v) { o.robot_goal = v; return !v.empty(); }},
+      {"--crowd", [&](const std::string& v) {
+         int count = 0;
+         if (!parse_number(v, 0, 500, count)) return false;
+         o.crowd = count;
+         return true;
+       }},
       {"--quality", [&](const std::string& v) { return parse_number(v, 1, 100, o.jpeg_quality); }},
       {"--max-clients", [&](const std::string& v) { return parse_number(v, 1, 64, o.max_clients); }},
       {"--web-root", [&](const std::string& v) { o.web_root = v; return !v.empty(); }},

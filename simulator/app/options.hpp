@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,7 +17,11 @@ struct SimOptions {
   int height = 720;                 ///< frame height, pixels
   int fps = 30;                     ///< frames rendered per second while a client is connected
   int tick_hz = 60;                 ///< fixed simulation steps per second
-  std::uint64_t seed = 1;           ///< master seed for every random stream
+  std::optional<std::uint64_t> seed;  ///< master seed for every random stream; unset = the scenario's
+  std::string scenario;             ///< scenario name or path; empty = the built-in test room
+  /// Scenario overrides: a spawn point's name or "x,y,yaw" (checked when the scenario is loaded).
+  std::optional<std::string> avatar_start, avatar_goal, robot_start, robot_goal;
+  std::optional<int> crowd;         ///< number of pedestrians instead of the scenario's
   int jpeg_quality = 80;            ///< 1..100
   int max_clients = 4;
   std::string web_root;             ///< empty = the built or installed page

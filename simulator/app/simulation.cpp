@@ -10,7 +10,9 @@ Simulation::Simulation(SimulationParams params, World initial) : params_(params)
 
 void Simulation::step() {
   // Stages in order: input (already applied to controls_), avatar, camera, clock.
-  step_avatar(params_.avatar, controls_.state(), world_.map, params_.dt, world_.avatar);
+  // Props block the avatar too; a world built without an obstacle grid has only its walls.
+  const GridMap& solid = world_.obstacles.width > 0 ? world_.obstacles : world_.map;
+  step_avatar(params_.avatar, controls_.state(), solid, params_.dt, world_.avatar);
   step_camera(params_.camera, controls_.state(), params_.dt, world_.camera);
   ++world_.tick;
   world_.time = static_cast<double>(world_.tick) * params_.dt;

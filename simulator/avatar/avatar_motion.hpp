@@ -25,7 +25,14 @@ struct CameraParams {
   double climb_rate = 1.5;  ///< m/s while Up or Down is held
 };
 
-/// Advances the avatar by dt seconds under `controls`, sliding along walls instead of entering them.
+/// Turns the avatar and changes its speed toward what `controls` command, by dt seconds; does not move it
+/// (the physics does, or step_avatar).
+void steer_avatar(const AvatarParams& params, const ControlState& controls, double dt, Avatar& avatar);
+
+/// Advances the walking cycle and the distance walked by `moved` metres.
+void advance_avatar_gait(const AvatarParams& params, double moved, Avatar& avatar);
+
+/// Steers and moves the avatar by dt seconds without physics, sliding along the map's walls.
 void step_avatar(const AvatarParams& params, const ControlState& controls, const GridMap& map, double dt,
                  Avatar& avatar);
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// GlRenderer: one shader, four unit meshes, one draw call per item.
+// GlRenderer: one shader, four unit meshes, one draw call per item with only changed state set.
 #include "render/gl_renderer.hpp"
 
 #define GL_GLEXT_PROTOTYPES 1
@@ -272,23 +272,44 @@ void GlRenderer::draw(const Scene& scene, int width, int height) {
   glUniform3fv(impl_->u_eye, 1, scene.camera.eye.data());
   glUniform2f(impl_->u_fog, scene.fog_start, scene.fog_end);
 
+  // Per item only the model and normal matrices change as a rule; the mesh, colour, opacity and surface are
+  // set only when they differ from the previous item's (a scene of a few thousand items repeats them a lot).
   std::uint64_t triangles = 0;
+  const Mesh* bound = nullptr;
+  Eigen::Vector3f last_color = Eigen::Vector3f::Constant(-1.0f);
+  float last_opacity = -1.0f;
+  int last_surface = -1;
   const auto draw_item = [&](const DrawItem& item) {
     const Eigen::Matrix4f model = item.model.matrix();
     const Eigen::Matrix3f normal_matrix = item.model.linear().inverse().transpose();
     glUniformMatrix4fv(impl_->u_model, 1, GL_FALSE, model.data());
     glUniformMatrix3fv(impl_->u_normal_matrix, 1, GL_FALSE, normal_matrix.data());
-    glUniform3fv(impl_->u_color, 1, item.color.data());
-    glUniform1f(impl_->u_opacity, item.opacity);
-    glUniform1i(impl_->u_surface, static_cast<int>(item.surface));
+    if (item.color != last_color) {
+      glUniform3fv(impl_->u_color, 1, item.color.data());
+      last_color = item.color;
+    }
+    if (item.opacity != last_opacity) {
+      glUniform1f(impl_->u_opacity, item.opacity);
+      last_opacity = item.opacity;
+    }
+    if (static_cast<int>(item.surface) != last_surface) {
+      last_surface = static_cast<int>(item.surface);
+      glUniform1i(impl_->u_surface, last_surface);
+    }
     const Mesh& mesh = impl_->meshes[static_cast<std::size_t>(item.shape)];
-    glBindVertexArray(mesh.vao);
+    if (&mesh != bound) {
+      glBindVertexArray(mesh.vao);
+      bound = &mesh;
+    }
     glDrawArrays(GL_TRIANGLES, 0, mesh.vertices);
     triangles += static_cast<std::uint64_t>(mesh.vertices / 3);
   };
-  // Opaque items first; translucent ones (shadows) blend over them without writing depth.
-  for (const DrawItem& item : scene.items) {
-    if (item.opacity >= 1.0f) draw_item(item);
+  // Opaque items first, one shape at a time (the depth test makes their order free), so each mesh is
+  // bound once; translucent ones (shadows) then blend over them in scene order without writing depth.
+  for (std::size_t shape = 0; shape < impl_->meshes.size(); ++shape) {
+    for (const DrawItem& item : scene.items) {
+      if (item.opacity >= 1.0f && static_cast<std::size_t>(item.shape) == shape) draw_item(item);
+    }
   }
   glEnable(GL_BLEND);
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);

@@ -13,12 +13,28 @@ struct SceneStyle {
   float avatar_height = 1.75f;    ///< m, top of the head
 };
 
-/// Builds the frame's scene: floor, walls (merged runs), props, the avatar with its gait, its shadow, and a
-/// third-person camera behind the avatar at the rig's height.
+/// Builds the frame's scene: floor, walls (merged runs), props by kind, landmarks, the robot, the people and
+/// the avatar with their gaits and shadows, and a third-person camera behind the avatar at the rig's height.
 Scene build_scene(const World& world, const SceneStyle& style = {});
 
-/// Appends a walking humanoid standing at `pose`, facing its yaw, in `shirt` colour; `gait_phase` in radians
-/// swings the arms and legs, `height` scales the whole body.
+/// How one humanoid looks: colours (RGB 0..1) and how broad it is.
+struct HumanoidLook {
+  Eigen::Vector3f shirt{0.18f, 0.5f, 0.82f};
+  Eigen::Vector3f trousers{0.22f, 0.24f, 0.32f};
+  Eigen::Vector3f skin{0.86f, 0.68f, 0.55f};
+  Eigen::Vector3f hair{0.23f, 0.16f, 0.12f};
+  Eigen::Vector3f shoes{0.13f, 0.13f, 0.13f};
+  float build = 1.0f;  ///< width factor across the shoulders and hips, 1 = average
+};
+
+/// A pedestrian's look: `shirt`, with trousers, skin, hair, shoes and build picked deterministically from `id`.
+HumanoidLook humanoid_look(int id, const Eigen::Vector3f& shirt);
+
+/// Appends a walking humanoid whose feet stand at `position`, facing `yaw` (rad); `gait_phase` (rad) swings
+/// the arms and legs by `swing` (0 standing .. 1 full stride), `height` (m, top of the head) scales the body.
+void append_humanoid(std::vector<DrawItem>& items, const Eigen::Vector3f& position, float yaw, float gait_phase,
+                     float swing, float height, const HumanoidLook& look);
+/// The same with the default look in `shirt` colour (the avatar).
 void append_humanoid(std::vector<DrawItem>& items, const Eigen::Vector3f& position, float yaw, float gait_phase,
                      float swing, float height, const Eigen::Vector3f& shirt);
 

@@ -10,6 +10,8 @@ TEST_CASE("defaults and every option") {
   CHECK(d.error.empty());
   CHECK(d.options.bind == "127.0.0.1");
   CHECK(d.options.width == 1280);
+  CHECK_FALSE(d.options.seed);  // the scenario's seed unless one is given
+  CHECK(d.options.scenario.empty());
   const auto o = parse_sim_options({"--port", "0", "--width", "640", "--height", "480", "--fps", "60", "--seed", "42",
                                     "--bind", "0.0.0.0", "--quality", "90", "--max-clients", "2", "--egl",
                                     "surfaceless", "--web-root", "/tmp/w"});
@@ -18,12 +20,27 @@ TEST_CASE("defaults and every option") {
   CHECK(o.options.width == 640);
   CHECK(o.options.height == 480);
   CHECK(o.options.fps == 60);
-  CHECK(o.options.seed == 42);
+  CHECK(o.options.seed == std::uint64_t{42});
   CHECK(o.options.bind == "0.0.0.0");
   CHECK(o.options.jpeg_quality == 90);
   CHECK(o.options.max_clients == 2);
   CHECK(o.options.egl_platform == "surfaceless");
   CHECK(o.options.web_root == "/tmp/w");
+}
+
+TEST_CASE("scenario options are kept for the scenario loader to check") {
+  const auto o = parse_sim_options({"--scenario", "warehouse", "--avatar-start", "dock", "--avatar-goal", "1.5,2",
+                                    "--robot-start", "3,4,1.57", "--robot-goal", "aisle_1", "--crowd", "0"});
+  REQUIRE(o.error.empty());
+  CHECK(o.options.scenario == "warehouse");
+  CHECK(o.options.avatar_start == std::string("dock"));
+  CHECK(o.options.avatar_goal == std::string("1.5,2"));
+  CHECK(o.options.robot_start == std::string("3,4,1.57"));
+  CHECK(o.options.robot_goal == std::string("aisle_1"));
+  CHECK(o.options.crowd == 0);
+  CHECK(parse_sim_options({"--crowd", "501"}).error == "bad value '501' for --crowd");
+  CHECK(parse_sim_options({"--crowd", "-1"}).error == "bad value '-1' for --crowd");
+  CHECK(parse_sim_options({"--scenario", ""}).error == "bad value '' for --scenario");
 }
 
 TEST_CASE("bad arguments are named") {

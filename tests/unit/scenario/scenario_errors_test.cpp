@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Broken scenario files: each mistake is reported with the file, the key and what was expected.
+#include <catch2/catch.hpp>
+
+#include <unistd.h>
+
+#include <fstream>
+
+#include "scenario/scenario.hpp"
+
+using namespace rfbsim::sim;
+
+namespace {
+
+// A scratch folder with a valid 4 x 4 m map (0.1 m cells, a wall all round) and scenario text to try.
+class ScratchScenario {
+ public:
+  ScratchScenario() {
+    static int counter = 0;
+    dir_ = std::filesystem::temp_directory_path() /
+           ("rfbsim_scenario_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    std::filesystem::create_directories(dir_);
+    std::ofstream pgm(dir_ / "room.pgm", std::ios::binary);
+    pgm << "P5\n40 40\n255\n";
+    for (int row = 0; row < 40; ++row) {
+      for (int col = 0; col < 40; ++col) {
+        const bool wall = row < 2 || row >= 38 || col < 2 || col >= 38;
+        pgm.put(static_cast<char>(wall ? 0 : 254));
+      }
+    }
+    pgm.close();
+    write("room.yaml",
+          "image: room.pgm\nresolution: 0.1\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+          "occupied_thresh: 0.65\nfree_thresh: 0.196\n");
+  }
+  ~ScratchScenario() { std::filesystem::remove_all(dir_); }
+  ScratchScenario(const ScratchScenario&) = delete;
+  ScratchScenario& operator=(const ScratchScenario&) = delete;
+
+  void write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+  }
+  // The message of the ScenarioError that loading `text` as s.yaml throws ("" if none).
+  std::string error_of(const std::string& text) const {
+    write("s.yaml", text);
+    try {
+      (void)load_scenario(dir_ / "s.yaml");
+    } catch (const ScenarioError& e) {
+      return e.what();
+    }
+    return "";
+  }
+  [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
+
+ private:
+  std::filesystem::path dir_;
+};
+
+const std::string kValid =
+    "map: room.yaml\n"
+    "spawns:\n  a: [1.0, 1.0, 0.0]\n  b: [3.0, 3.0, 0.0]\n"
+    "avatar:\n  start: a\n";
+
+}  // namespace
+
+TEST_CASE("a minimal valid scenario loads") {
+  ScratchScenario scratch;
+  CHECK(scratch.error_of(kValid).empty());
+  scratch.write("s.yaml", kValid);
+  const Scenario s = load_scenario(scratch.dir() / "s.yaml");
+  CHECK(s.name == "s");
+  CHECK(s.map.width == 40);
+  CHECK(s.avatar_start.x == 1.0);
+  CHECK_FALSE(s.robot.present);
+  CHECK(s.crowd.count == 0);
+}
+
+TEST_CASE("scenario mistakes name the file, the key and what was expected") {
+  ScratchScenario scratch;
+  struct Case {
+    const char* what;
+    std::string text;
+    std::vector<std::string> needles;
+  };
+  const std::vector<Case> cases = {
+      {"missing avatar", "map: room.yaml\n", {"s.yaml", "missing key 'avatar'"}},
+      {"missing map", "avatar:\n  start: [1, 1]\n", {"s.yaml", "missing key 'map'"}},
+      {"crowd count not a number", kValid + "crowd:\n  count: many\n  goals: [a, b]\n",
+       {"s.yaml:", "key 'crowd.count'", "expected an integer 0..500", "'many'"}},
+      {"wrong type for props", kValid + "props: 3\n", {"key 'props'", "expected a list"}},
+      {"prop size too short", kValid + "props:\n  - kind: box\n    pose: [2, 2]\n    size: [1, 1]\n",
+       {"key 'props[0].size'", "a list of 3"}},
+      {"unknown prop kind", kValid + "props:\n  - kind: sofa\n    pose: [2, 2]\n    size: [1, 1, 1]\n",
+       {"key 'props[0].kind'", "box, shelf or desk", "'sofa'"}},
+      {"unknown spawn name", "map: room.yaml\nspawns:\n  a: [1.0, 1.0]\navatar:\n  start: door\n",
+       {"key 'avatar.start'", "no spawn point 'door'", "known: a"}},
+      {"misspelt key", kValid + "crwod:\n  count: 2\n", {"key 'crwod'", "unknown key"}},
+      {"spawn inside a wall", "map: room.yaml\nspawns:\n  w: [0.05, 2.0]\navatar:\n  start: w\n",
+       {"key 'spawns.w'", "inside or against a wall"}},
+      {"start off the map", "map: room.yaml\navatar:\n  start: [9.0, 9.0]\n", {"s.yaml", "off the map"}},
+      {"crowd without places", kValid + "crowd:\n  count: 3\n", {"key 'crowd'", "'routes' or 'goals'"}},
+      {"colour unquoted", kValid + "landmarks:\n  - name: g\n    position: [2, 2]\n    color: 12\n",
+       {"key 'landmarks[0].color'", "#rrggbb"}},
+      {"mission type", kValid + "robot:\n  start: b\n  mission:\n    type: dance\n",
+       {"key 'robot.mission.type'", "goto, patrol, wander or none"}},
+      {"malformed YAML", "map: [room.yaml\navatar: {start: a\n", {"s.yaml:", "not valid YAML"}},
+      {"a list at the top", "- map\n", {"s.yaml", "expected a mapping"}},
+      {"map file missing", "map: nowhere.yaml\navatar:\n  start: [1, 1]\n", {"s.yaml", "key 'map'", "nowhere.yaml"}},
+  };
+  for (const Case& c : cases) {
+    INFO(c.what);
+    const std::string message = scratch.error_of(c.text);
+    INFO(message);
+    REQUIRE_FALSE(message.empty());
+    for (const auto& needle : c.needles) CHECK_THAT(message, Catch::Contains(needle));
+  }
+}
+
+TEST_CASE("a map image that cannot be read is reported through the scenario's map key") {
+  ScratchScenario scratch;
+  scratch.write("room.pgm", "P5\n40 40\n255\nshort");  // truncated pixels
+  const std::string message = scratch.error_of(kValid);
+  INFO(message);
+  CHECK_THAT(message, Catch::Contains("s.yaml") && Catch::Contains("key 'map'") && Catch::Contains("room.pgm"));
+  scratch.write("room.pgm", "GIF89a garbage");
+  CHECK_THAT(scratch.error_of(kValid), Catch::Contains("room.pgm"));
+}
+
+TEST_CASE("no file is read when the scenario file itself is missing") {
+  try {
+    (void)load_scenario("/nonexistent/dir/s.yaml");
+    FAIL("loaded a missing file");
+  } catch (const ScenarioError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("/nonexistent/dir/s.yaml") && Catch::Contains("cannot open"));
+  }
+}

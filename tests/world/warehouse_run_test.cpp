@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Long runs of the shipped scenarios through every system: nobody leaves the map or walks into a wall,
+// no number goes NaN, and a participant who walks into the robot pushes it (SEAN-EP: 18 % did).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "scripted_run.hpp"
+
+using rfbsim::test::ScriptedKey;
+
+namespace {
+
+bool finite(const std::vector<double>& values) {
+  for (double v : values) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("ten minutes of warehouse: nobody leaves the map or stands in a wall, no NaN") {
+  auto simulation = rfbsim::test::make_scenario_simulation("warehouse", 5);
+  const auto& world = simulation->world();
+  // The participant wanders: walk, turn a little, walk, for the whole ten minutes.
+  constexpr std::uint64_t kTicks = 10 * 60 * 60;
+  std::uint64_t worst_tick = 0;
+  int bad = 0;
+  simulation->apply_key('w', true);
+  for (std::uint64_t tick = 0; tick < kTicks; ++tick) {
+    if (tick % 240 == 0) simulation->apply_key('a', true);
+    if (tick % 240 == 40) simulation->apply_key('a', false);
+    simulation->step();
+    const auto poses = rfbsim::test::agent_poses(world);
+    bool ok = finite(poses);
+    // Centres stay on the map and out of walls and props (bodies may touch them, not enter).
+    for (std::size_t i = 0; ok && i + 2 < poses.size(); i += 3) {
+      ok = world.map.contains(poses[i], poses[i + 1]) && !world.obstacles.is_occupied_at(poses[i], poses[i + 1]);
+    }
+    if (!ok && bad++ == 0) worst_tick = tick;
+  }
+  INFO("first bad tick " << worst_tick);
+  CHECK(bad == 0);
+  CHECK(world.people.size() == 15);
+}
+
+TEST_CASE("walking into the standing robot pushes it, and the contact is an event") {
+  // In the warehouse's cross aisle: the avatar 1.5 m west of the robot, facing it, nobody else around.
+  rfbsim::sim::ScenarioOverrides overrides;
+  overrides.robot_start = "10.0,18.5,0";
+  overrides.avatar_start = "8.5,18.5,0";
+  overrides.crowd_count = 0;
+  auto simulation = rfbsim::test::make_scenario_simulation("warehouse", 1, overrides);
+  const auto& world = simulation->world();
+  REQUIRE(world.robot);
+  const double robot_x0 = world.robot->pose.x;
+  int avatar_robot_contacts = 0;
+  double impulse = 0.0;
+  simulation->apply_key('w', true);
+  for (int tick = 0; tick < 5 * 60; ++tick) {
+    simulation->step();
+    for (const auto& contact : world.contacts) {
+      if (contact.a == rfbsim::sim::Party::Avatar && contact.b == rfbsim::sim::Party::Robot) {
+        ++avatar_robot_contacts;
+        impulse += contact.impulse;
+        CHECK(contact.tick == world.tick - 1);
+      }
+    }
+  }
+  CHECK(avatar_robot_contacts >= 1);
+  CHECK(impulse > 0.0);
+  CHECK(world.robot->pose.x - robot_x0 > 0.3);
+  // The avatar stays behind the robot: it pushes, it does not pass through.
+  CHECK(world.avatar.pose.x < world.robot->pose.x);
+}
