@@ -3,8 +3,13 @@
 #include <sys/wait.h>
 
 #include <catch2/catch.hpp>
-#include <csignal>
+
+#include <unistd.h>
+
 #include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <thread>
 
@@ -121,6 +126,25 @@ TEST_CASE("bad command lines and setup failures exit with a clear message") {
   const auto no_page = rfbsim::test::run_to_exit(rfbsim::test::sim_rfb_path(), {"--port", "0", "--web-root", "/nonexistent"});
   CHECK(WEXITSTATUS(no_page.status) == 1);
   CHECK_THAT(no_page.output, Catch::Contains("no index.html"));
+
+  // Scenarios: a misspelt name, a bad override and a broken file each end it with 2 and say why.
+  const auto unknown_scenario = rfbsim::test::run_to_exit(rfbsim::test::sim_rfb_path(),
+                                                          {"--port", "0", "--scenario", "warhouse"});
+  CHECK(WEXITSTATUS(unknown_scenario.status) == 2);
+  CHECK_THAT(unknown_scenario.output, Catch::Contains("scenario 'warhouse' not found") &&
+                                          Catch::Contains("warehouse") && Catch::Contains("lab"));
+  const auto bad_start = rfbsim::test::run_to_exit(
+      rfbsim::test::sim_rfb_path(), {"--port", "0", "--scenario", "lab", "--avatar-start", "1,2,3,4"});
+  CHECK(WEXITSTATUS(bad_start.status) == 2);
+  CHECK_THAT(bad_start.output, Catch::Contains("--avatar-start: '1,2,3,4'"));
+  const auto broken = std::filesystem::temp_directory_path() / ("rfbsim_broken_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(broken) << "map: lab.yaml\navatar:\n  start: [1, 1]\ncrowd: {count: x}\n";
+  const auto broken_file = rfbsim::test::run_to_exit(rfbsim::test::sim_rfb_path(),
+                                                     {"--port", "0", "--scenario", broken.string()});
+  std::filesystem::remove(broken);
+  CHECK(WEXITSTATUS(broken_file.status) == 2);
+  CHECK_THAT(broken_file.output, Catch::Contains(broken.string()) && Catch::Contains("key 'map'"));
+  CHECK_THAT(broken_file.output, !Catch::Contains("ready"));
 
   const auto help = rfbsim::test::run_to_exit(rfbsim::test::sim_rfb_path(), {"--help"});
   CHECK(WEXITSTATUS(help.status) == 0);
