@@ -264,7 +264,14 @@ Server::Impl::~Impl() {
   const std::uint64_t one = 1;
   [[maybe_unused]] auto n = ::write(wake_fd, &one, sizeof one);
   if (thread.joinable()) thread.join();
-  // The network thread is gone: closing the clients here runs on_client_gone on this thread.
+  // Tell browsers this is a shutdown, not a network failure: a WebSocket close frame, 1001 "going away"
+  // (RFC 6455 5.5.1; a server's frames are unmasked). No update is being written now: the thread is gone.
+  for (rfbClientPtr cl = screen->clientHead; cl != nullptr; cl = cl->next) {
+    if (cl->sock == RFB_INVALID_SOCKET || cl->wsctx == nullptr) continue;
+    constexpr unsigned char kGoingAway[] = {0x88, 0x02, 0x03, 0xE9};
+    [[maybe_unused]] auto sent = ::send(cl->sock, kGoingAway, sizeof kGoingAway, MSG_DONTWAIT | MSG_NOSIGNAL);
+  }
+  // Closing the clients here runs on_client_gone on this thread.
   rfbShutdownServer(screen, TRUE);
   rfbScreenCleanup(screen);
   for (const auto& connection : pending) ::close(connection.fd);

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <atomic>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -124,4 +125,25 @@ TEST_CASE("websocketpp client completes the RFB handshake over WebSocket and get
     std::this_thread::sleep_for(10ms);  // the network thread notices the close on its next poll
   }
   CHECK(server.client_count() == 0);
+}
+
+TEST_CASE("a server that shuts down says so to WebSocket clients with a going-away close frame",
+          "[robustness][websocket]") {
+  rfbsim::ServerOptions options;
+  options.width = kWidth;
+  options.height = kHeight;
+  auto server = std::make_unique<rfbsim::Server>(options);
+  WsTestClient ws(server->port(), "/websockify", "http://127.0.0.1:" + std::to_string(server->port()), "binary");
+  const rfbsim::test::ReadExact read = [&ws](std::size_t n, std::vector<std::uint8_t>& out) {
+    return ws.read_exact(n, out, 5s);
+  };
+  const rfbsim::test::WriteAll write = [&ws](const std::vector<std::uint8_t>& bytes) { return ws.send_binary(bytes); };
+  (void)rfbsim::test::rfb_client_handshake(read, write);
+  REQUIRE(rfbsim::test::eventually([&] { return server->client_count() == 1; }, 2s));
+  CHECK(ws.remote_close_code() == -1);
+
+  server.reset();  // what SIGTERM does in sim_rfb
+  REQUIRE(rfbsim::test::eventually([&] { return !ws.open(); }, 5s));
+  // 1001: the page can tell "the simulation ended" from a network failure (1006, no close frame).
+  CHECK(ws.remote_close_code() == 1001);
 }

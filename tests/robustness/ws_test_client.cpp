@@ -32,6 +32,7 @@ struct WsTestClient::Impl {
   std::deque<std::uint8_t> received;
   std::uint64_t binary = 0;
   std::uint64_t text = 0;
+  int remote_close_code = -1;  // the code in the server's close frame; -1 before one arrived
 
   template <typename Predicate>
   bool wait(std::unique_lock<std::mutex>& lock, std::chrono::milliseconds timeout, Predicate predicate) {
@@ -88,7 +89,15 @@ WsTestClient::WsTestClient(int port, const std::string& path, const std::string&
     }
     self.set_state(State::kFailed);
   });
-  self.endpoint.set_close_handler([&self](websocketpp::connection_hdl) { self.set_state(State::kClosed); });
+  self.endpoint.set_close_handler([&self](websocketpp::connection_hdl hdl) {
+    {
+      std::lock_guard lock(self.mutex);
+      const auto connection = self.endpoint.get_con_from_hdl(hdl);
+      // websocketpp reports "no status" (1005) or "abnormal" (1006) when no close frame arrived.
+      self.remote_close_code = static_cast<int>(connection->get_remote_close_code());
+    }
+    self.set_state(State::kClosed);
+  });
   self.endpoint.set_message_handler([&self](websocketpp::connection_hdl, Endpoint::message_ptr message) {
     {
       std::lock_guard lock(self.mutex);
@@ -184,6 +193,11 @@ void WsTestClient::close(std::chrono::milliseconds timeout) {
   });
   std::unique_lock lock(self.mutex);
   self.wait(lock, timeout, [&self] { return self.state != State::kOpen; });
+}
+
+int WsTestClient::remote_close_code() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->remote_close_code;
 }
 
 }  // namespace rfbsim::test

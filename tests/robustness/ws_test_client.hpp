@@ -40,6 +40,9 @@ class WsTestClient {
   [[nodiscard]] std::uint64_t text_messages() const;
   /// Whether the connection is open (false once either side closed it).
   [[nodiscard]] bool open() const;
+  /// The status code of the close frame the server sent (1005 or 1006 when the connection ended without
+  /// one), or -1 while the connection has not closed.
+  [[nodiscard]] int remote_close_code() const;
   /// Starts a normal close (1001 going away) and waits up to `timeout` for it to finish.
   void close(std::chrono::milliseconds timeout = std::chrono::seconds(2));
 
