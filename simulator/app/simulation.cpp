@@ -6,14 +6,18 @@
 
 namespace rfbsim::sim {
 
-Simulation::Simulation(SimulationParams params, World initial) : params_(params), world_(std::move(initial)) {}
+Simulation::Simulation(SimulationParams params, World initial)
+    : params_(params), world_(std::move(initial)), physics_(std::make_unique<PhysicsWorld>(world_, params_.physics)) {}
+
+Simulation::~Simulation() = default;
 
 void Simulation::step() {
-  // Stages in order: input (already applied to controls_), avatar, camera, clock.
-  // Props block the avatar too; a world built without an obstacle grid has only its walls.
-  const GridMap& solid = world_.obstacles.width > 0 ? world_.obstacles : world_.map;
-  step_avatar(params_.avatar, controls_.state(), solid, params_.dt, world_.avatar);
+  // Input (already applied to controls_): the avatar's wanted speed and heading, and the camera rig.
+  steer_avatar(params_.avatar, controls_.state(), params_.dt, world_.avatar);
   step_camera(params_.camera, controls_.state(), params_.dt, world_.camera);
+  // Physics: everybody moves as far as walls, props and each other let them (the avatar's gait with
+  // the distance it really moved); contacts that began become events in world_.contacts.
+  physics_->step(world_, params_.dt);
   ++world_.tick;
   world_.time = static_cast<double>(world_.tick) * params_.dt;
 }

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "avatar/avatar_controls.hpp"
 #include "avatar/avatar_motion.hpp"
+#include "physics/physics_world.hpp"
 #include "world/world.hpp"
 
 namespace rfbsim::sim {
@@ -17,17 +19,22 @@ struct SimulationParams {
   double dt = 1.0 / 60.0;  ///< s per tick
   AvatarParams avatar;
   CameraParams camera;
+  PhysicsParams physics;
 };
 
 class Simulation {
  public:
+  /// Builds the physics of `initial` (walls, props, avatar, people, robot).
   Simulation(SimulationParams params, World initial);
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
 
   /// Applies one key event; it takes effect from the next step.
   void apply_key(std::uint32_t keysym, bool down) { controls_.apply_key(keysym, down); }
   /// Releases every control (the participant left).
   void release_controls() { controls_.release_all(); }
-  /// Advances one fixed tick: avatar, camera, clock.
+  /// Advances one fixed tick: input, avatar, camera, physics, clock.
   void step();
 
   [[nodiscard]] const World& world() const { return world_; }
@@ -38,6 +45,7 @@ class Simulation {
   SimulationParams params_;
   World world_;
   AvatarControls controls_;
+  std::unique_ptr<PhysicsWorld> physics_;
 };
 
 /// The status document served at /status.json: tick, time, avatar pose, camera height, plus what the

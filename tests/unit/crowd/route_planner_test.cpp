@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Pedestrian routes on tiny maps: straight when nothing is in the way, around a shelf, through a gap
+// narrower than the clearance, none into a closed room.
+#include <catch2/catch.hpp>
+
+#include "crowd/route_planner.hpp"
+
+using namespace rfbsim::sim;
+
+namespace {
+
+// Every leg of the route, from `from`, keeps the clearance the planner reports.
+void check_legs_clear(const RoutePlanner& planner, const Eigen::Vector2d& from, const PlannedRoute& route) {
+  Eigen::Vector2d at = from;
+  for (const Eigen::Vector2d& w : route.waypoints) {
+    INFO("leg to " << w.transpose());
+    CHECK(planner.line_clear(at, w, route.clearance));
+    at = w;
+  }
+}
+
+}  // namespace
+
+TEST_CASE("in an open room the route is the goal itself") {
+  const GridMap map = grid_from_text({"##########", "#........#", "#........#", "#........#", "#........#",
+                                      "##########"},
+                                     0.5);
+  const RoutePlanner planner(map);
+  const PlannedRoute route = planner.plan({1.0, 1.0}, {3.5, 1.5}, 0.3);
+  REQUIRE(route.waypoints.size() == 1);
+  CHECK(route.waypoints[0] == Eigen::Vector2d(3.5, 1.5));
+  CHECK(route.clearance == 0.3);
+}
+
+TEST_CASE("a route goes around a shelf between start and goal, in a few waypoints") {
+  // 10 m x 6 m at 0.25 m; a shelf 1 m thick from the bottom wall up to y = 4.25 m at x = 4.5..5.5.
+  GridMap map;
+  map.width = 40;
+  map.height = 24;
+  map.resolution = 0.25;
+  map.occupied.assign(40 * 24, 0);
+  for (int row = 0; row < map.height; ++row) {
+    for (int col = 0; col < map.width; ++col) {
+      const bool border = row == 0 || col == 0 || row == map.height - 1 || col == map.width - 1;
+      const bool shelf = col >= 18 && col < 22 && row < 17;
+      map.occupied[static_cast<std::size_t>(row * map.width + col)] = border || shelf ? 1 : 0;
+    }
+  }
+  const RoutePlanner planner(map);
+  const Eigen::Vector2d from(2.0, 1.5);
+  const Eigen::Vector2d to(8.0, 1.5);
+  CHECK_FALSE(planner.line_clear(from, to, 0.3));
+  const PlannedRoute route = planner.plan(from, to, 0.3);
+  REQUIRE(!route.waypoints.empty());
+  CHECK(route.clearance == 0.3);
+  CHECK(route.waypoints.back() == to);
+  CHECK(route.waypoints.size() <= 4);
+  check_legs_clear(planner, from, route);
+  // Over the shelf's top (y = 4.25) with the clearance: some waypoint lies above y = 4.25 + 0.3.
+  bool over = false;
+  for (const Eigen::Vector2d& w : route.waypoints) over = over || w.y() > 4.5;
+  CHECK(over);
+}
+
+TEST_CASE("a gap narrower than the clearance is still used when it is the only way") {
+  // One-cell (0.5 m) door in a wall: no cell in it keeps 0.3 m from both sides, so the planner falls back.
+  const GridMap map = grid_from_text({"###########", "#.........#", "#.........#", "#####.#####", "#.........#",
+                                      "#.........#", "###########"},
+                                     0.5);
+  const RoutePlanner planner(map);
+  const PlannedRoute route = planner.plan({1.0, 1.0}, {4.0, 2.25}, 0.3);
+  REQUIRE(!route.waypoints.empty());
+  CHECK(route.clearance == 0.15);
+  CHECK(route.waypoints.back() == Eigen::Vector2d(4.0, 2.25));
+  check_legs_clear(planner, {1.0, 1.0}, route);
+}
+
+TEST_CASE("no route into a closed room; a goal inside a wall moves to the nearest free cell") {
+  const GridMap map = grid_from_text({"###########", "#...#.....#", "#...#.....#", "#...#.....#", "###########"},
+                                     0.5);
+  const RoutePlanner planner(map);
+  CHECK(planner.plan({1.0, 1.0}, {4.0, 1.0}, 0.3).waypoints.empty());
+  // (2.25, 1.25) is in the dividing wall (column 4); the nearest free cell centre is (1.75, 1.25).
+  const PlannedRoute route = planner.plan({1.0, 1.0}, {2.1, 1.25}, 0.0);
+  REQUIRE(route.waypoints.size() == 1);
+  CHECK(route.waypoints[0].x() == Approx(1.75));
+  CHECK(route.waypoints[0].y() == Approx(1.25));
+}
