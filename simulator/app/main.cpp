@@ -87,7 +87,7 @@ std::unique_ptr<rfbsim::sim::Simulation> make_simulation(const rfbsim::sim::SimO
   sim::apply_overrides(scenario, overrides);
   std::fprintf(stderr, "[sim_rfb] scenario %s (%s), seed %llu, %d people\n", scenario.name.c_str(),
                file.string().c_str(), static_cast<unsigned long long>(scenario.seed), scenario.crowd.count);
-  return std::make_unique<sim::Simulation>(params, sim::make_world(scenario));
+  return std::make_unique<sim::Simulation>(params, sim::make_world(scenario), scenario.crowd);
 }
 
 int run(const rfbsim::sim::SimOptions& options) {

@@ -2,35 +2,66 @@
 // Simulation: the fixed-step stages in order.
 #include "app/simulation.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <vector>
 
 namespace rfbsim::sim {
 
-Simulation::Simulation(SimulationParams params, World initial)
-    : params_(params), world_(std::move(initial)), physics_(std::make_unique<PhysicsWorld>(world_, params_.physics)) {}
+namespace {
+
+World with_people(World world, const Crowd& crowd) {
+  world.people = crowd.spawn();
+  return world;
+}
+
+}  // namespace
+
+Simulation::Simulation(SimulationParams params, World initial, CrowdSpec crowd)
+    : params_(params),
+      crowd_(initial, std::move(crowd), params.crowd),
+      physics_() {
+  world_ = with_people(std::move(initial), crowd_);
+  physics_ = std::make_unique<PhysicsWorld>(world_, params_.physics);
+}
 
 Simulation::~Simulation() = default;
 
 void Simulation::step() {
-  // Input (already applied to controls_): the avatar's wanted speed and heading, and the camera rig.
+  // Input (already applied to controls_): the avatar's wanted speed and heading.
   steer_avatar(params_.avatar, controls_.state(), params_.dt, world_.avatar);
   step_camera(params_.camera, controls_.state(), params_.dt, world_.camera);
-  // Physics: everybody moves as far as walls, props and each other let them (the avatar's gait with
-  // the distance it really moved); contacts that began become events in world_.contacts.
+  // Crowd: each person's wanted velocity from the social forces.
+  crowd_.step(world_, params_.dt);
+  // Physics: everybody moves as far as walls, props and each other let them; contacts become events.
+  std::vector<Eigen::Vector2d> before;
+  before.reserve(world_.people.size());
+  for (const Person& person : world_.people) before.emplace_back(person.pose.x, person.pose.y);
   physics_->step(world_, params_.dt);
+  for (std::size_t i = 0; i < world_.people.size(); ++i) {
+    Person& person = world_.people[i];
+    advance_gait(person, (Eigen::Vector2d(person.pose.x, person.pose.y) - before[i]).norm());
+  }
   ++world_.tick;
   world_.time = static_cast<double>(world_.tick) * params_.dt;
 }
 
 std::string status_json(const World& world, int clients, std::uint64_t frames_rendered) {
-  char text[512];
+  char text[768];
   std::snprintf(text, sizeof text,
                 "{\"tick\":%llu,\"time\":%.4f,\"clients\":%d,\"frames_rendered\":%llu,"
-                "\"avatar\":{\"x\":%.4f,\"y\":%.4f,\"yaw\":%.4f,\"speed\":%.4f},\"camera_height\":%.3f}",
+                "\"avatar\":{\"x\":%.4f,\"y\":%.4f,\"yaw\":%.4f,\"speed\":%.4f},\"camera_height\":%.3f,"
+                "\"people\":%zu",
                 static_cast<unsigned long long>(world.tick), world.time, clients,
                 static_cast<unsigned long long>(frames_rendered), world.avatar.pose.x, world.avatar.pose.y,
-                world.avatar.pose.yaw, world.avatar.speed, world.camera.height);
-  return text;
+                world.avatar.pose.yaw, world.avatar.speed, world.camera.height, world.people.size());
+  std::string json = text;
+  if (world.robot) {
+    std::snprintf(text, sizeof text, ",\"robot\":{\"x\":%.4f,\"y\":%.4f,\"yaw\":%.4f}", world.robot->pose.x,
+                  world.robot->pose.y, world.robot->pose.yaw);
+    json += text;
+  }
+  return json + "}";
 }
 
 }  // namespace rfbsim::sim

@@ -9,6 +9,7 @@
 
 #include "avatar/avatar_controls.hpp"
 #include "avatar/avatar_motion.hpp"
+#include "crowd/crowd.hpp"
 #include "physics/physics_world.hpp"
 #include "world/world.hpp"
 
@@ -19,13 +20,14 @@ struct SimulationParams {
   double dt = 1.0 / 60.0;  ///< s per tick
   AvatarParams avatar;
   CameraParams camera;
+  SocialForceParams crowd;
   PhysicsParams physics;
 };
 
 class Simulation {
  public:
-  /// Builds the physics of `initial` (walls, props, avatar, people, robot).
-  Simulation(SimulationParams params, World initial);
+  /// Spawns the crowd described by `crowd` into `initial` and builds the physics of the result.
+  Simulation(SimulationParams params, World initial, CrowdSpec crowd = {});
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -34,7 +36,7 @@ class Simulation {
   void apply_key(std::uint32_t keysym, bool down) { controls_.apply_key(keysym, down); }
   /// Releases every control (the participant left).
   void release_controls() { controls_.release_all(); }
-  /// Advances one fixed tick: input, avatar, camera, physics, clock.
+  /// Advances one fixed tick: input, avatar, crowd, physics, clock.
   void step();
 
   [[nodiscard]] const World& world() const { return world_; }
@@ -45,11 +47,12 @@ class Simulation {
   SimulationParams params_;
   World world_;
   AvatarControls controls_;
+  Crowd crowd_;
   std::unique_ptr<PhysicsWorld> physics_;
 };
 
-/// The status document served at /status.json: tick, time, avatar pose, camera height, plus what the
-/// caller adds about clients and frames.
+/// The status document served at /status.json: tick, time, avatar pose, camera height, people, robot,
+/// contacts so far, plus what the caller adds about clients and frames.
 std::string status_json(const World& world, int clients, std::uint64_t frames_rendered);
 
 }  // namespace rfbsim::sim

@@ -40,8 +40,8 @@ TEST_CASE("the warehouse run twice with one seed and one key script matches bit 
     }
   }
   CHECK(first_difference == kTicks);
-  // The run did something: the avatar walked and the crowd moved.
-  CHECK(std::abs(a.back()[1] - a.front()[1]) > 3.0);
+  // The run did something: the avatar walked (it may bump into people and racks) and the crowd moved.
+  CHECK(first->world().avatar.distance_walked > 3.0);
   double crowd_motion = 0.0;
   for (std::size_t i = 3; i + 3 < a.back().size(); i += 3) crowd_motion += std::abs(a.back()[i] - a.front()[i]);
   CHECK(crowd_motion > 10.0);
@@ -54,8 +54,9 @@ TEST_CASE("another seed gives another crowd") {
   auto other = rfbsim::test::make_scenario_simulation("warehouse", 12);
   const auto a = rfbsim::test::run_scripted(*one, {}, 60);
   const auto b = rfbsim::test::run_scripted(*other, {}, 60);
-  // The avatar and the robot start where the scenario says; the people do not.
-  CHECK(a.back()[0] == b.back()[0]);
+  // The avatar starts where the scenario says whatever the seed; the people do not.
+  CHECK(a.front()[0] == Approx(b.front()[0]).margin(1e-3));
+  CHECK(a.front()[1] == Approx(b.front()[1]).margin(1e-3));
   int people_elsewhere = 0;
   for (std::size_t i = 3; i + 3 < a.back().size(); i += 3) {
     if (std::hypot(a.back()[i] - b.back()[i], a.back()[i + 1] - b.back()[i + 1]) > 0.5) ++people_elsewhere;

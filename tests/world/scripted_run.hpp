@@ -24,7 +24,7 @@ inline std::unique_ptr<sim::Simulation> make_scenario_simulation(const std::stri
   sim::Scenario scenario = sim::load_scenario(std::string(RFBSIM_SCENARIO_DIR) + "/" + name + ".yaml");
   overrides.seed = seed;
   sim::apply_overrides(scenario, overrides);
-  return std::make_unique<sim::Simulation>(sim::SimulationParams{}, sim::make_world(scenario));
+  return std::make_unique<sim::Simulation>(sim::SimulationParams{}, sim::make_world(scenario), scenario.crowd);
 }
 
 /// Every agent's x, y, yaw in a fixed order: avatar, people by index, robot.
