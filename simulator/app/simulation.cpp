@@ -34,8 +34,8 @@ void Simulation::step() {
   // Crowd: each person's wanted velocity from the social forces.
   crowd_.step(world_, params_.dt);
   // Physics: everybody moves as far as walls, props and each other let them; contacts become events.
-  std::vector<Eigen::Vector2d> before;
-  before.reserve(world_.people.size());
+  auto& before = positions_before_physics_;
+  before.clear();
   for (const Person& person : world_.people) before.emplace_back(person.pose.x, person.pose.y);
   physics_->step(world_, params_.dt);
   for (std::size_t i = 0; i < world_.people.size(); ++i) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "avatar/avatar_controls.hpp"
 #include "avatar/avatar_motion.hpp"
@@ -49,6 +50,7 @@ class Simulation {
   AvatarControls controls_;
   Crowd crowd_;
   std::unique_ptr<PhysicsWorld> physics_;
+  std::vector<Eigen::Vector2d> positions_before_physics_;  // reused each tick: how far each person moved
 };
 
 /// The status document served at /status.json: tick, time, avatar pose, camera height, people, robot,

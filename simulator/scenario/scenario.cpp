@@ -84,11 +84,7 @@ void check_free(const Scenario& scenario, const GridMap& obstacles, const Pose2&
   throw ScenarioError(scenario.file.string() + ": " + problem);
 }
 
-GridMap obstacles_of(const Scenario& scenario) {
-  GridMap obstacles = scenario.map;
-  for (const Prop& prop : scenario.props) obstacles.block_box(prop.x, prop.y, prop.size_x, prop.size_y, prop.yaw);
-  return obstacles;
-}
+GridMap obstacles_of(const Scenario& scenario) { return with_props_blocked(scenario.map, scenario.props); }
 
 void parse_props(Scenario& scenario, const YamlField& list) {
   for (const YamlField& item : list.sequence()) {
@@ -138,7 +134,7 @@ void parse_props(Scenario& scenario, const YamlField& list) {
   }
 }
 
-void parse_crowd(Scenario& scenario, const YamlField& crowd, bool seed_given) {
+void parse_crowd(Scenario& scenario, const GridMap& obstacles, const YamlField& crowd, bool seed_given) {
   crowd.allow_only({"count", "seed", "speed", "routes", "goals"});
   CrowdSpec& spec = scenario.crowd;
   spec.count = crowd.required("count").integer(0, kMaxPeople);
@@ -155,7 +151,6 @@ void parse_crowd(Scenario& scenario, const YamlField& crowd, bool seed_given) {
     if (auto v = speed->optional("max")) spec.speed_max = v->number(0.1, 4.0);
     if (spec.speed_min > spec.speed_max) speed->fail_with("min is above max");
   }
-  const GridMap obstacles = obstacles_of(scenario);
   const auto place_on_floor = [&](const YamlField& field) {
     const Pose2 pose = parse_place(scenario, field);
     check_free(scenario, obstacles, pose, 0.2, "this point", &field);
@@ -322,7 +317,7 @@ Scenario load_scenario(const std::filesystem::path& file) {
     parse_robot(scenario, *robot);
     check_free(scenario, obstacles, scenario.robot.start, kRobotClearance, "robot.start", nullptr);
   }
-  if (auto crowd = root.optional("crowd")) parse_crowd(scenario, *crowd, seed_given);
+  if (auto crowd = root.optional("crowd")) parse_crowd(scenario, obstacles, *crowd, seed_given);
   return scenario;
 }
 

@@ -18,8 +18,7 @@ World make_demo_world() {
       {5.0, 3.2, 0.8, 1.4, 1.0, 0x5a78a0},
       {-4.5, 3.5, 0.8, 0.8, 1.6, 0xb08850},
   };
-  world.obstacles = world.map;
-  for (const Prop& prop : world.props) world.obstacles.block_box(prop.x, prop.y, prop.size_x, prop.size_y, prop.yaw);
+  world.obstacles = with_props_blocked(world.map, world.props);
   world.avatar.pose = {3.5, -1.0, std::numbers::pi / 2.0};
   return world;
 }

@@ -112,4 +112,10 @@ struct World {
   std::vector<ContactEvent> contacts;  ///< contacts that began during the last tick
 };
 
+/// `map` with every prop's box blocked too: what World::obstacles holds.
+inline GridMap with_props_blocked(GridMap map, const std::vector<Prop>& props) {
+  for (const Prop& prop : props) map.block_box(prop.x, prop.y, prop.size_x, prop.size_y, prop.yaw);
+  return map;
+}
+
 }  // namespace rfbsim::sim
