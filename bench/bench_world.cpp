@@ -3,7 +3,8 @@
 // stage per tick (crowd, physics, the whole Simulation::step); for both shipped scenes the time to build
 // and render one 1280x720 frame off-screen. Prints tables; never passes or fails.
 //
-//   bench_world [--ticks N] [--frames N] [--size WxH] [--scenarios warehouse,lab]
+//   bench_world [--ticks N] [--frames N] [--size WxH] [--samples N] [--scenarios warehouse,lab]
+//   --samples: MSAA samples (default: automatic, as sim_rfb: 4 on a GPU, none on llvmpipe)
 //
 // llvmpipe's thread count comes from LP_NUM_THREADS (unset: one per core); the table says which.
 #include <GL/gl.h>
@@ -33,6 +34,7 @@ struct Options {
   int frames = 120;
   bench::Size size{1280, 720};
   std::vector<std::string> scenarios{"warehouse", "lab"};
+  int samples = rfbsim::OffscreenGLOptions::kAutoSamples;  // MSAA, as sim_rfb renders unless told
 };
 
 sim::Scenario load(const std::string& name) {
@@ -97,12 +99,13 @@ void bench_render(const Options& options) {
   rfbsim::OffscreenGLOptions gl_options;
   gl_options.width = options.size.width;
   gl_options.height = options.size.height;
+  gl_options.samples = options.samples;
   rfbsim::OffscreenGL gl(gl_options);
   sim::GlRenderer renderer;
   const char* threads = std::getenv("LP_NUM_THREADS");
   std::printf("\nrender %s with %s, LP_NUM_THREADS=%s\n", options.size.text().c_str(), gl.renderer().c_str(),
               threads != nullptr ? threads : "(unset: one per core)");
-  bench::Table table({"scenario", "stage", "frames", "items", "p50 ms", "p90 ms", "mean ms"});
+  bench::Table table({"scenario", "stage", "frames", "items", "draw calls", "p50 ms", "p90 ms", "mean ms"});
   for (const std::string& name : options.scenarios) {
     const sim::Scenario scenario = load(name);
     sim::Simulation simulation(sim::SimulationParams{}, sim::make_world(scenario), scenario.crowd);
@@ -110,6 +113,7 @@ void bench_render(const Options& options) {
     std::vector<double> draw_ms;
     std::vector<double> readback_ms;
     std::size_t items = 0;
+    std::size_t draw_calls = 0;
     for (int frame = 0; frame < options.frames + 10; ++frame) {
       for (int t = 0; t < 2; ++t) {  // 60 Hz ticks, 30 frames per second
         script_keys(simulation, frame * 2 + t);
@@ -126,14 +130,15 @@ void bench_render(const Options& options) {
       const auto t3 = Clock::now();
       if (frame < 10) continue;  // warm-up: shader compilation, first uploads
       items = scene.items.size();
+      draw_calls = renderer.last_draw_calls();
       build_ms.push_back(bench::ms_between(t0, t1));
       draw_ms.push_back(bench::ms_between(t1, t2));
       readback_ms.push_back(bench::ms_between(t2, t3));
     }
     const auto row = [&](const char* stage, const std::vector<double>& samples) {
       const bench::Summary s = bench::summarize(samples);
-      table.add_row({name, stage, std::to_string(s.n), std::to_string(items), bench::fixed(s.p50, 2),
-                     bench::fixed(s.p90, 2), bench::fixed(s.mean, 2)});
+      table.add_row({name, stage, std::to_string(s.n), std::to_string(items), std::to_string(draw_calls),
+                     bench::fixed(s.p50, 2), bench::fixed(s.p90, 2), bench::fixed(s.mean, 2)});
     };
     row("build scene", build_ms);
     row("render", draw_ms);
@@ -154,6 +159,8 @@ Options parse(int argc, char** argv) {
       options.frames = bench::parse_int(value, 1, 100'000, arg);
     } else if (arg == "--size") {
       options.size = bench::parse_sizes(value).at(0);
+    } else if (arg == "--samples") {
+      options.samples = bench::parse_int(value, 0, 16, arg);
     } else if (arg == "--scenarios") {
       options.scenarios = bench::split_list(value);
     } else {

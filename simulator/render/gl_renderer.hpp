@@ -3,6 +3,7 @@
 // simulator; it needs a current context (rfbsim::OffscreenGL) on the calling thread for its whole life.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -18,15 +19,19 @@ class GlRenderer {
   GlRenderer(const GlRenderer&) = delete;
   GlRenderer& operator=(const GlRenderer&) = delete;
 
-  /// Clears to the sky colour and draws every item: opaque first, then translucent ones.
+  /// Clears to the sky colour and draws every item in the order plan_draws gives (opaque, nearest first;
+  /// floors; translucent), one instanced call per batch.
   void draw(const Scene& scene, int width, int height);
   /// Triangles submitted by the last draw().
   [[nodiscard]] std::uint64_t last_triangles() const { return last_triangles_; }
+  /// Draw calls made by the last draw(): one per batch of the draw plan.
+  [[nodiscard]] std::size_t last_draw_calls() const { return last_draw_calls_; }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::uint64_t last_triangles_ = 0;
+  std::size_t last_draw_calls_ = 0;
 };
 
 /// Column-major perspective projection (OpenGL clip space).

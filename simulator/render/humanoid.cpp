@@ -66,8 +66,9 @@ void append_humanoid(std::vector<DrawItem>& items, const Eigen::Vector3f& positi
   }
   items.push_back(
       shape_item(Shape::Sphere, body, {0.0f, 0.0f, 1.63f + bob}, Eigen::Vector3f::Constant(0.24f), look.skin));
-  // Hair caps the head a little to the back, so the face shows which way the person looks.
-  items.push_back(shape_item(Shape::Sphere, body, {-0.015f, 0.0f, 1.675f + bob}, {0.25f, 0.25f, 0.15f}, look.hair));
+  // Hair caps the head a little to the back, so the face shows which way the person looks. Its crown is
+  // 1 cm above the head's, or the faceted head would poke through it.
+  items.push_back(shape_item(Shape::Sphere, body, {-0.015f, 0.0f, 1.68f + bob}, {0.256f, 0.256f, 0.16f}, look.hair));
   // A nose-like marker shows which way the person faces, even from behind and above.
   items.push_back(box_item(body, {0.12f, 0.0f, 1.62f + bob}, {0.06f, 0.05f, 0.05f}, look.skin * 0.8f));
 }

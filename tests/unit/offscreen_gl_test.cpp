@@ -51,6 +51,21 @@ TEST_CASE("two contexts share the process's display and bad sizes are refused") 
   CHECK_THROWS_AS(rfbsim::OffscreenGL({0, 16, 0, "auto"}), std::runtime_error);
 }
 
+TEST_CASE("automatic MSAA is off on a software rasterizer and 4x on a GPU; an explicit count is kept") {
+  rfbsim::OffscreenGL automatic({64, 64, rfbsim::OffscreenGLOptions::kAutoSamples, "auto"});
+  const std::string name = automatic.renderer();
+  const bool software = name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos;
+  INFO(name);
+  CHECK(automatic.samples() == (software ? 0 : 4));
+  CHECK(rfbsim::OffscreenGL({64, 64, 4, "auto"}).samples() == 4);
+  CHECK(rfbsim::OffscreenGL({64, 64, 1, "auto"}).samples() == 0);
+  // Without multisampling the picture is read straight from the drawing framebuffer.
+  automatic.begin_frame();
+  glClearColor(1.0f, 0.0f, 0.0f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  CHECK(pixel(automatic.read_frame(), 3, 60) == std::array<int, 4>{255, 0, 0, 255});
+}
+
 TEST_CASE("the demo scene renders sky above and the avatar's blue shirt at the centre") {
   rfbsim::OffscreenGL gl({320, 240, 4, "auto"});
   rfbsim::sim::GlRenderer renderer;

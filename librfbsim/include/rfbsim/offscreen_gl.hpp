@@ -13,9 +13,13 @@ namespace rfbsim {
 
 /// Definition of an off-screen context.
 struct OffscreenGLOptions {
+  static constexpr int kAutoSamples = -1;
+
   int width = 1280;   ///< FBO width in pixels (> 0)
   int height = 720;   ///< FBO height in pixels (> 0)
-  int samples = 4;    ///< MSAA samples; 0 or 1 = none (resolved before read-back)
+  /// MSAA samples (resolved before read-back); 0 or 1 = none. kAutoSamples: 4 on a GPU, none on a
+  /// software rasterizer (Mesa llvmpipe or softpipe), where 4x MSAA costs more than the rest of the frame.
+  int samples = kAutoSamples;
   /// Which EGL platform to use: "auto" tries the device platform (GPUs, e.g. NVIDIA) and then Mesa's
   /// surfaceless platform (llvmpipe on machines without a GPU); or "device" / "surfaceless".
   std::string platform = "auto";
@@ -41,7 +45,10 @@ class OffscreenGL {
 
   [[nodiscard]] int width() const;
   [[nodiscard]] int height() const;
-  /// GL_RENDERER and the EGL platform in use, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) via surfaceless".
+  /// MSAA samples in use (0 = none): options.samples, or what kAutoSamples chose for this renderer.
+  [[nodiscard]] int samples() const;
+  /// GL_RENDERER, the EGL platform and the MSAA in use, e.g.
+  /// "llvmpipe (LLVM 15.0.6, 256 bits) via surfaceless, no MSAA".
   [[nodiscard]] std::string renderer() const;
 
  private:
