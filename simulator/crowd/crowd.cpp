@@ -44,6 +44,15 @@ constexpr std::uint32_t kShirts[] = {0x8a5a9e, 0x3f6fb5, 0xb5473f, 0x4f8f4a, 0xc
 
 constexpr double kSpawnGap = 0.15;  // m kept between bodies and from walls at spawn
 
+// Whether someone other than `self` stands on `point`: their centre within two body radii (0.5 m) of it.
+bool taken_by_other(const Eigen::Vector2d& point, const std::vector<Neighbour>& bodies, std::size_t self) {
+  constexpr double kStandingOn = 0.5;
+  for (std::size_t j = 0; j < bodies.size(); ++j) {
+    if (j != self && (bodies[j].position - point).squaredNorm() < kStandingOn * kStandingOn) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 Crowd::Crowd(const World& world, CrowdSpec spec, SocialForceParams params)
@@ -170,7 +179,8 @@ void Crowd::plan_to_goal(Walker& w, const Eigen::Vector2d& from) {
   w.stalled_for = 0.0;
 }
 
-Eigen::Vector2d Crowd::desired_direction(Walker& w, const Person& person, double dt) {
+Eigen::Vector2d Crowd::desired_direction(Walker& w, const Person& person, const std::vector<Neighbour>& bodies,
+                                         std::size_t self, double dt) {
   const Eigen::Vector2d here(person.pose.x, person.pose.y);
   const bool single_point = w.route >= 0 && spec_.routes[static_cast<std::size_t>(w.route)].size() <= 1;
   // Waypoints reached (intermediate ones with a wider radius, so people round corners), then the goal.
@@ -181,8 +191,9 @@ Eigen::Vector2d Crowd::desired_direction(Walker& w, const Person& person, double
   }
   double distance = (w.waypoints[w.next] - here).norm();
   const bool last = w.next + 1 == w.waypoints.size();
-  if (last && distance < params_.goal_radius) {
-    if (single_point) return Eigen::Vector2d::Zero();  // stands at its only point
+  if (last && (distance < params_.goal_radius ||
+               (distance < params_.taken_goal_radius && taken_by_other(w.waypoints[w.next], bodies, self)))) {
+    if (single_point) return Eigen::Vector2d::Zero();  // stands at (or next to) its only point
     ++w.goals_reached;
     choose_next_goal(w);
     plan_to_goal(w, here);
@@ -210,29 +221,28 @@ Eigen::Vector2d Crowd::desired_direction(Walker& w, const Person& person, double
 void Crowd::step(World& world, double dt) {
   assert(world.people.size() == walkers_.size() && "Crowd::step: world.people is not what spawn() returned");
   const std::size_t n = std::min(world.people.size(), walkers_.size());
-  // The avatar and the robot, as people moving with their velocities.
-  std::vector<Neighbour> others;
-  if (params_.react_to_avatar) {
-    const Avatar& a = world.avatar;
-    others.push_back({{a.pose.x, a.pose.y}, a.speed * Eigen::Vector2d(std::cos(a.pose.yaw), std::sin(a.pose.yaw))});
-  }
-  if (params_.react_to_robot && world.robot) {
-    others.push_back({{world.robot->pose.x, world.robot->pose.y}, world.robot->velocity});
-  }
-  // Everyone's forces from the same snapshot, so that the order of people does not matter.
-  std::vector<Neighbour> now(n);
+  // Everyone's forces from the same snapshot, so that the order of people does not matter: the people,
+  // then the avatar and the robot as people moving with their velocities.
+  std::vector<Neighbour>& now = bodies_;
+  now.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     now[i] = {{world.people[i].pose.x, world.people[i].pose.y}, world.people[i].velocity};
+  }
+  if (params_.react_to_avatar) {
+    const Avatar& a = world.avatar;
+    now.push_back({{a.pose.x, a.pose.y}, a.speed * Eigen::Vector2d(std::cos(a.pose.yaw), std::sin(a.pose.yaw))});
+  }
+  if (params_.react_to_robot && world.robot) {
+    now.push_back({{world.robot->pose.x, world.robot->pose.y}, world.robot->velocity});
   }
   const DistanceField& field = planner_.field();
   for (std::size_t i = 0; i < n; ++i) {
     Person& person = world.people[i];
-    const Eigen::Vector2d e = desired_direction(walkers_[i], person, dt);
+    const Eigen::Vector2d e = desired_direction(walkers_[i], person, now, i, dt);
     Eigen::Vector2d force = goal_force(now[i].velocity, e, person.desired_speed, params_);
-    for (std::size_t j = 0; j < n; ++j) {
+    for (std::size_t j = 0; j < now.size(); ++j) {
       if (j != i) force += pedestrian_force(now[i], e, now[j], params_);
     }
-    for (const Neighbour& o : others) force += pedestrian_force(now[i], e, o, params_);
     force += wall_force(now[i].position, field, params_);
 
     // Semi-implicit Euler: the new velocity is what moves the body this tick.

@@ -62,13 +62,17 @@ class Crowd {
   void choose_next_goal(Walker& walker);
   void plan_to_goal(Walker& walker, const Eigen::Vector2d& from);
   [[nodiscard]] Eigen::Vector2d random_free_point(std::mt19937_64& rng) const;
-  [[nodiscard]] Eigen::Vector2d desired_direction(Walker& walker, const Person& person, double dt);
+  /// The way person `self` wants to walk; `bodies` are everyone this tick (people first, in order, then
+  /// the avatar and the robot), to tell whether its goal is taken.
+  [[nodiscard]] Eigen::Vector2d desired_direction(Walker& walker, const Person& person,
+                                                  const std::vector<Neighbour>& bodies, std::size_t self, double dt);
 
   CrowdSpec spec_;
   SocialForceParams params_;
   RoutePlanner planner_;
   std::vector<Person> spawned_;
   std::vector<Walker> walkers_;
+  std::vector<Neighbour> bodies_;  // reused each step: everyone's position and velocity this tick
 };
 
 /// Moves every person by velocity * dt, with no physics (tests, benches), advancing the gait.

@@ -13,9 +13,7 @@ namespace rfbsim::sim {
 
 namespace {
 
-std::size_t index_of(const GridMap& map, Cell c) {
-  return static_cast<std::size_t>(c.row) * static_cast<std::size_t>(map.width) + static_cast<std::size_t>(c.col);
-}
+constexpr std::size_t kNoParent = std::numeric_limits<std::size_t>::max();
 
 }  // namespace
 
@@ -57,60 +55,106 @@ Eigen::Vector2d RoutePlanner::nearest_free(const Eigen::Vector2d& p, int max_cel
 std::vector<Cell> RoutePlanner::search(Cell start, Cell goal, double clearance) const {
   const GridMap& m = map();
   const double res = m.resolution;
-  const std::size_t cells = static_cast<std::size_t>(m.width) * static_cast<std::size_t>(m.height);
   // The start and goal cells may be narrower than the clearance: the person already stands there or must go.
   const auto open_cell = [&](Cell c) {
     return c == start || c == goal ? !m.is_occupied(c) : walkable(c, clearance);
   };
   if (!open_cell(start) || !open_cell(goal)) return {};
+
+  // Nodes: blocks of k x k cells, each stood for by its middle cell, except that the start's block is
+  // stood for by the start; one more node is the goal itself. A 20 x 30 m map at 0.05 m has 240 000 cells
+  // but 15 000 blocks of 0.2 m, which makes a route across it some 15 times cheaper to find, and a person
+  // needs no finer steps: the route is straightened afterwards on the cells themselves.
+  const int k = std::max(1, static_cast<int>(std::lround(params_.search_step / res)));
+  const int blocks_x = (m.width + k - 1) / k;
+  const int blocks_y = (m.height + k - 1) / k;
+  const std::size_t blocks = static_cast<std::size_t>(blocks_x) * static_cast<std::size_t>(blocks_y);
+  const std::size_t goal_node = blocks;
+  const auto node_of_block = [&](int bx, int by) {
+    return static_cast<std::size_t>(by) * static_cast<std::size_t>(blocks_x) + static_cast<std::size_t>(bx);
+  };
+  const std::size_t start_node = node_of_block(start.col / k, start.row / k);
+  const auto cell_of_node = [&](std::size_t node) {
+    if (node == goal_node) return goal;
+    if (node == start_node) return start;
+    const int bx = static_cast<int>(node % static_cast<std::size_t>(blocks_x));
+    const int by = static_cast<int>(node / static_cast<std::size_t>(blocks_x));
+    return Cell{std::min(bx * k + k / 2, m.width - 1), std::min(by * k + k / 2, m.height - 1)};
+  };
+
+  // A step between two open node cells. Between neighbouring cells (k = 1), a diagonal step must not cut
+  // a corner. Longer steps need every cell on the segment open, except when the clearance alone rules
+  // out a wall on it: the distance to walls changes by at most the distance moved, so a segment whose
+  // ends keep `clearance` (the start and goal need not) keeps clearance - length / 2 everywhere, more
+  // than a cell when the clearance is large enough.
+  const auto step_open = [&](Cell a, Cell b) {
+    const int dc = b.col - a.col;
+    const int dr = b.row - a.row;
+    if (std::abs(dc) <= 1 && std::abs(dr) <= 1) {
+      return dc == 0 || dr == 0 || (open_cell({a.col + dc, a.row}) && open_cell({a.col, a.row + dr}));
+    }
+    const double length = res * std::hypot(dc, dr);
+    if (clearance >= 0.5 * length + res && walkable(a, clearance) && walkable(b, clearance)) return true;
+    const int samples = static_cast<int>(std::ceil(2.0 * std::hypot(dc, dr)));  // every half cell
+    for (int i = 1; i < samples; ++i) {
+      const double t = static_cast<double>(i) / samples;
+      const Cell c{a.col + static_cast<int>(std::lround(t * dc)), a.row + static_cast<int>(std::lround(t * dr))};
+      if (!open_cell(c)) return false;
+    }
+    return true;
+  };
   // Cost per metre grows near walls so that routes keep to the middle of aisles where they can.
   const auto cost_factor = [&](Cell c) {
     const double surface = std::max(0.0, field_.at_cell(c) - 0.5 * res);
     return 1.0 + params_.wall_cost * std::max(0.0, 1.0 - surface / params_.comfort_distance);
   };
-  const auto heuristic = [&](Cell c) {  // octile distance: admissible, every step costs at least its length
-    const double dx = std::abs(c.col - goal.col);
-    const double dy = std::abs(c.row - goal.row);
-    return res * (std::max(dx, dy) + (std::sqrt(2.0) - 1.0) * std::min(dx, dy));
-  };
-  std::vector<double> cost(cells, std::numeric_limits<double>::infinity());
-  std::vector<int> parent(cells, -1);
-  std::vector<std::uint8_t> closed(cells, 0);
-  // Ordered by (f, cell index): equal f values pop in index order, so the result never depends on the heap.
+  const auto metres = [&](Cell a, Cell b) { return res * std::hypot(a.col - b.col, a.row - b.row); };
+
+  std::vector<double> cost(blocks + 1, std::numeric_limits<double>::infinity());
+  std::vector<std::size_t> parent(blocks + 1, kNoParent);
+  std::vector<std::uint8_t> closed(blocks + 1, 0);
+  // A* with the straight-line distance (admissible: every step costs at least its length), ordered by
+  // (f, node): equal f values pop in node order, so the result never depends on the heap.
   using Entry = std::tuple<double, std::size_t>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
-  cost[index_of(m, start)] = 0.0;
-  open.emplace(heuristic(start), index_of(m, start));
-  constexpr int kDc[8] = {1, -1, 0, 0, 1, 1, -1, -1};
-  constexpr int kDr[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  const auto relax = [&](std::size_t from, Cell from_cell, std::size_t to, Cell to_cell) {
+    if (closed[to] != 0 || !open_cell(to_cell) || !step_open(from_cell, to_cell)) return;
+    const double step = metres(from_cell, to_cell) * 0.5 * (cost_factor(from_cell) + cost_factor(to_cell));
+    const double total = cost[from] + step;
+    if (total < cost[to]) {
+      cost[to] = total;
+      parent[to] = from;
+      open.emplace(total + metres(to_cell, goal), to);
+    }
+  };
+  const int goal_bx = goal.col / k;
+  const int goal_by = goal.row / k;
+  cost[start_node] = 0.0;
+  open.emplace(metres(start, goal), start_node);
   while (!open.empty()) {
     const std::size_t at = std::get<1>(open.top());
     open.pop();
     if (closed[at] != 0) continue;
     closed[at] = 1;
-    const Cell c{static_cast<int>(at % static_cast<std::size_t>(m.width)),
-                 static_cast<int>(at / static_cast<std::size_t>(m.width))};
-    if (c == goal) break;
-    for (int k = 0; k < 8; ++k) {
-      const Cell n{c.col + kDc[k], c.row + kDr[k]};
-      if (n.col < 0 || n.row < 0 || n.col >= m.width || n.row >= m.height || !open_cell(n)) continue;
-      const bool diagonal = k >= 4;
-      // No corner cutting: a diagonal step needs both cells it passes between to be open too.
-      if (diagonal && (!open_cell({c.col + kDc[k], c.row}) || !open_cell({c.col, c.row + kDr[k]}))) continue;
-      const std::size_t ni = index_of(m, n);
-      const double step = (diagonal ? std::sqrt(2.0) : 1.0) * res * 0.5 * (cost_factor(c) + cost_factor(n));
-      if (cost[at] + step < cost[ni]) {
-        cost[ni] = cost[at] + step;
-        parent[ni] = static_cast<int>(at);
-        open.emplace(cost[ni] + heuristic(n), ni);
+    if (at == goal_node) break;
+    const Cell c = cell_of_node(at);
+    const int bx = static_cast<int>(at % static_cast<std::size_t>(blocks_x));
+    const int by = static_cast<int>(at / static_cast<std::size_t>(blocks_x));
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int nx = bx + dx;
+        const int ny = by + dy;
+        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= blocks_x || ny >= blocks_y) continue;
+        const std::size_t n = node_of_block(nx, ny);
+        relax(at, c, n, cell_of_node(n));
       }
     }
+    // The goal node joins its own block and the eight around it.
+    if (std::abs(bx - goal_bx) <= 1 && std::abs(by - goal_by) <= 1) relax(at, c, goal_node, goal);
   }
-  if (parent[index_of(m, goal)] < 0 && !(start == goal)) return {};
+  if (closed[goal_node] == 0) return {};
   std::vector<Cell> path;
-  for (int i = static_cast<int>(index_of(m, goal)); i >= 0; i = parent[static_cast<std::size_t>(i)]) {
-    path.push_back({i % m.width, i / m.width});
-  }
+  for (std::size_t node = goal_node; node != kNoParent; node = parent[node]) path.push_back(cell_of_node(node));
   std::reverse(path.begin(), path.end());
   return path;
 }

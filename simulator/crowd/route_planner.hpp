@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// RoutePlanner: a pedestrian's way between two points around shelves and walls: A* over the cells of the
-// obstacle map that keep a clearance from walls, shortened to a few waypoints a person can walk straight.
+// RoutePlanner: a pedestrian's way between two points around shelves and walls: A* over blocks of cells of
+// the obstacle map that keep a clearance from walls, shortened to a few waypoints a person can walk straight.
 #pragma once
 
 #include <Eigen/Core>
@@ -15,6 +15,7 @@ namespace rfbsim::sim {
 struct RoutePlannerParams {
   double comfort_distance = 1.0;  ///< m: cells nearer than this to a wall cost more to walk through
   double wall_cost = 2.0;         ///< extra cost factor at a wall's surface, falling linearly to 0 at comfort
+  double search_step = 0.2;       ///< m: the search steps between blocks of cells about this wide
 };
 
 /// A planned route: waypoints in world metres (the first leg starts where the person stands, which is not

@@ -67,6 +67,9 @@ struct SocialForceParams {
   // Walking behaviour (rfbsim choices).
   double goal_radius = 0.3;       ///< m: a goal counts as reached this near (PySocialForce: 0.2)
   double waypoint_radius = 0.6;   ///< m: an intermediate waypoint counts as reached this near
+  /// m: a goal that someone else stands on (their centre within 0.5 m of it) counts as reached this near,
+  /// so that people do not shove a standing robot, the avatar or another person off their spot
+  double taken_goal_radius = 1.0;
   double clearance = 0.3;         ///< m: routes keep the body centre this far from walls (radius + 5 cm)
   double turn_rate = 4.0;         ///< rad/s: how fast the body turns toward the way it walks
   double stall_time = 4.0;        ///< s: no progress toward the waypoint for this long => re-plan

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "crowd/route_planner.hpp"
 #include "scripted_run.hpp"
 
 using rfbsim::test::ScriptedKey;
@@ -43,4 +44,30 @@ TEST_CASE("ten minutes of warehouse: nobody leaves the map or stands in a wall, 
   INFO("first bad tick " << worst_tick);
   CHECK(bad == 0);
   CHECK(world.people.size() == 15);
+}
+
+namespace sim = rfbsim::sim;
+
+TEST_CASE("every pair of the warehouse's crowd goals is joined by a route that keeps the full clearance") {
+  sim::Scenario scenario = sim::load_scenario(std::string(RFBSIM_SCENARIO_DIR) + "/warehouse.yaml");
+  const sim::World world = sim::make_world(scenario);
+  const sim::RoutePlanner planner(world.obstacles);
+  const auto& goals = scenario.crowd.goals;
+  REQUIRE(goals.size() >= 10);
+  for (const Eigen::Vector2d& from : goals) {
+    for (const Eigen::Vector2d& to : goals) {
+      if (from == to) continue;
+      INFO("from " << from.transpose() << " to " << to.transpose());
+      const sim::PlannedRoute route = planner.plan(from, to, 0.3);
+      REQUIRE(!route.waypoints.empty());
+      CHECK(route.clearance == 0.3);
+      CHECK(route.waypoints.back() == to);
+      CHECK(route.waypoints.size() <= 6);  // straightened: a few legs, not a staircase of cells
+      Eigen::Vector2d at = from;
+      for (const Eigen::Vector2d& w : route.waypoints) {
+        CHECK(planner.line_clear(at, w, route.clearance));
+        at = w;
+      }
+    }
+  }
 }

@@ -9,6 +9,23 @@ using namespace rfbsim::sim;
 
 namespace {
 
+// A map of cols x rows cells of `res` m with a one-cell wall border, plus the cells `blocked(col, row)` names.
+template <typename Blocked>
+GridMap bordered_map(int cols, int rows, double res, Blocked blocked) {
+  GridMap map;
+  map.width = cols;
+  map.height = rows;
+  map.resolution = res;
+  map.occupied.assign(static_cast<std::size_t>(cols * rows), 0);
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < cols; ++col) {
+      const bool border = row == 0 || col == 0 || row == rows - 1 || col == cols - 1;
+      map.occupied[static_cast<std::size_t>(row * cols + col)] = border || blocked(col, row) ? 1 : 0;
+    }
+  }
+  return map;
+}
+
 // Every leg of the route, from `from`, keeps the clearance the planner reports.
 void check_legs_clear(const RoutePlanner& planner, const Eigen::Vector2d& from, const PlannedRoute& route) {
   Eigen::Vector2d at = from;
@@ -34,19 +51,9 @@ TEST_CASE("in an open room the route is the goal itself") {
 
 TEST_CASE("a route goes around a shelf between start and goal, in a few waypoints") {
   // 10 m x 6 m at 0.25 m; a shelf 1 m thick from the bottom wall up to y = 4.25 m at x = 4.5..5.5.
-  GridMap map;
-  map.width = 40;
-  map.height = 24;
-  map.resolution = 0.25;
-  map.occupied.assign(40 * 24, 0);
-  for (int row = 0; row < map.height; ++row) {
-    for (int col = 0; col < map.width; ++col) {
-      const bool border = row == 0 || col == 0 || row == map.height - 1 || col == map.width - 1;
-      const bool shelf = col >= 18 && col < 22 && row < 17;
-      map.occupied[static_cast<std::size_t>(row * map.width + col)] = border || shelf ? 1 : 0;
-    }
-  }
-  const RoutePlanner planner(map);
+  const RoutePlanner planner(bordered_map(40, 24, 0.25, [](int col, int row) {
+    return col >= 18 && col < 22 && row < 17;  // the shelf
+  }));
   const Eigen::Vector2d from(2.0, 1.5);
   const Eigen::Vector2d to(8.0, 1.5);
   CHECK_FALSE(planner.line_clear(from, to, 0.3));
@@ -85,4 +92,42 @@ TEST_CASE("no route into a closed room; a goal inside a wall moves to the neares
   REQUIRE(route.waypoints.size() == 1);
   CHECK(route.waypoints[0].x() == Approx(1.75));
   CHECK(route.waypoints[0].y() == Approx(1.25));
+}
+
+namespace {
+
+// 6 m x 4 m at 0.05 m with a wall one cell (5 cm) thick at x = 3.0 m, open between y = 1.6 and 2.4 when
+// `door`: a fine map, where the search steps between blocks of 4 x 4 cells.
+GridMap thin_wall_map(bool door) {
+  return bordered_map(120, 80, 0.05, [door](int col, int row) {
+    const double y = (row + 0.5) * 0.05;
+    return col == 60 && !(door && y > 1.6 && y < 2.4);
+  });
+}
+
+}  // namespace
+
+TEST_CASE("on a fine map the route goes through the door of a wall one cell thick, never through the wall") {
+  const RoutePlanner with_door(thin_wall_map(true));
+  const PlannedRoute route = with_door.plan({1.0, 1.0}, {5.0, 1.0}, 0.3);
+  REQUIRE(!route.waypoints.empty());
+  CHECK(route.clearance == 0.3);
+  check_legs_clear(with_door, {1.0, 1.0}, route);
+  // Every leg that crosses x = 3 crosses it in the door.
+  Eigen::Vector2d at(1.0, 1.0);
+  int crossings = 0;
+  for (const Eigen::Vector2d& w : route.waypoints) {
+    if ((at.x() - 3.0) * (w.x() - 3.0) < 0.0) {
+      const double y = at.y() + (w.y() - at.y()) * (3.0 - at.x()) / (w.x() - at.x());
+      CHECK(y > 1.6);
+      CHECK(y < 2.4);
+      ++crossings;
+    }
+    at = w;
+  }
+  CHECK(crossings == 1);
+  // Without the door there is no way at any clearance: the coarse steps do not jump the thin wall.
+  const RoutePlanner closed(thin_wall_map(false));
+  CHECK(closed.plan({1.0, 1.0}, {5.0, 1.0}, 0.3).waypoints.empty());
+  CHECK(closed.plan({2.9, 1.0}, {3.1, 1.0}, 0.3).waypoints.empty());
 }
