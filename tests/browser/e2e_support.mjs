@@ -1,0 +1,466 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Shared parts of the browser end-to-end tests (e2e_walk.mjs, e2e_scenes.mjs): progress and failure, sim_rfb
+// processes, a headless Chromium on the participant page, canvas pixels, and cleanup whatever happens.
+//
+// Every test script takes the same arguments (SIM_RFB ARTIFACTS_DIR [WEB_DIR], see parseArgs) and ends through
+// runTest, which always stops what was started and exits 0 (passed), 1 (a check failed) or 2 (overall timeout).
+
+import { spawn } from 'node:child_process';
+import fs from 'node:fs';
+import { createRequire } from 'node:module';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+
+// ---------------------------------------------------------------------------------------------------------------
+// Settings shared by every test.
+// ---------------------------------------------------------------------------------------------------------------
+export const READY_TIMEOUT_MS = 30_000;   // sim_rfb must print its ready line within this
+export const EXIT_TIMEOUT_MS = 10_000;    // sim_rfb must exit this soon after SIGTERM
+export const PIXEL_CHANGE_THRESHOLD = 48; // |dR| + |dG| + |dB| above this counts as a changed pixel
+export const CHROMIUM = process.env.RFBSIM_CHROMIUM || '/usr/bin/chromium';
+const CHROMIUM_ARGS = [
+  '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+  '--disable-background-networking', '--disable-component-update', '--disable-sync',
+];
+
+// ---------------------------------------------------------------------------------------------------------------
+// Progress and failure.
+// ---------------------------------------------------------------------------------------------------------------
+const t0 = Date.now();
+
+// Prints one progress line with the seconds since the test started.
+export function log(message) {
+  const seconds = ((Date.now() - t0) / 1000).toFixed(1).padStart(5);
+  console.log(`[e2e ${seconds}s] ${message}`);
+}
+
+// A check that did not hold: reported as `FAIL: message`, without a stack.
+export class CheckFailed extends Error {}
+
+export function check(condition, message) {
+  if (!condition) {
+    throw new CheckFailed(message);
+  }
+}
+
+export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+// Resolves with fn()'s first truthy value, polling every intervalMs; throws CheckFailed after timeoutMs.
+// A CheckFailed thrown by fn ends the wait at once; other errors (a refused fetch, say) are retried.
+export async function poll(what, timeoutMs, intervalMs, fn) {
+  const deadline = Date.now() + timeoutMs;
+  let lastError = null;
+  for (;;) {
+    try {
+      const value = await fn();
+      if (value) {
+        return value;
+      }
+    } catch (err) {
+      if (err instanceof CheckFailed) {
+        throw err;
+      }
+      lastError = err;
+    }
+    if (Date.now() >= deadline) {
+      const detail = lastError ? ` (last error: ${lastError.message})` : '';
+      throw new CheckFailed(`timed out after ${timeoutMs} ms waiting for ${what}${detail}`);
+    }
+    await sleep(intervalMs);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Arguments: SIM_RFB ARTIFACTS_DIR [WEB_DIR]. Prints the usage and exits 1 when they are missing.
+// ---------------------------------------------------------------------------------------------------------------
+
+// Returns { simPath, artifacts, webDir } with absolute artifacts and webDir (default: ../../web from here).
+export function parseArgs(scriptName) {
+  const [simPath, artifactsArg, webArg] = process.argv.slice(2);
+  if (!simPath || !artifactsArg) {
+    console.error(`usage: node ${scriptName} SIM_RFB ARTIFACTS_DIR [WEB_DIR]`);
+    process.exit(1);
+  }
+  return {
+    simPath,
+    artifacts: path.resolve(artifactsArg),
+    webDir: path.resolve(webArg || path.join(here, '..', '..', 'web')),
+  };
+}
+
+// Checks that sim_rfb and Chromium exist, creates the artifacts folder, and returns playwright's chromium.
+export function prepare(env) {
+  check(fs.existsSync(env.simPath), `sim_rfb not found at ${env.simPath}`);
+  check(fs.existsSync(CHROMIUM), `Chromium not found at ${CHROMIUM}`);
+  fs.mkdirSync(env.artifacts, { recursive: true });
+  log(`artifacts go to ${env.artifacts}`);
+
+  // playwright-core lives in web/node_modules (NODE_PATH does not reach ES module imports).
+  try {
+    return createRequire(path.join(env.webDir, 'package.json'))('playwright-core').chromium;
+  } catch (err) {
+    throw new CheckFailed(`cannot load playwright-core from ${env.webDir}/node_modules ` +
+                          `(run: npm ci --prefix ${env.webDir}): ${err.message}`);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// The simulator process: start, wait for the ready line, stop.
+// ---------------------------------------------------------------------------------------------------------------
+const sims = [];   // every sim_rfb started, for cleanup
+
+// Starts env.simPath with args (its output goes to ARTIFACTS/<name>.log) and resolves with the sim
+// { name, child, url, exited, ... } once it printed its ready line.
+export function startSim(env, name, args) {
+  log(`starting ${name}: ${env.simPath} ${args.join(' ')}`);
+  const logPath = path.join(env.artifacts, `${name}.log`);
+  const logFile = fs.createWriteStream(logPath);
+  const child = spawn(env.simPath, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+  const sim = { name, child, exited: null, logFile, logPath, tail: [] };
+  sims.push(sim);
+
+  const exited = new Promise((resolve) => {
+    child.on('exit', (code, signal) => {
+      sim.exited = { code, signal };
+      resolve(sim.exited);
+    });
+  });
+  sim.exitedPromise = exited;
+
+  // Keep the last lines of output for failure messages; everything goes to the log file.
+  const remember = (stream, label) => {
+    let partial = '';
+    stream.on('data', (chunk) => {
+      logFile.write(chunk);
+      partial += chunk.toString('utf8');
+      const lines = partial.split('\n');
+      partial = lines.pop();
+      for (const line of lines) {
+        sim.tail.push(`${label}: ${line}`);
+        if (sim.tail.length > 30) {
+          sim.tail.shift();
+        }
+        if (label === 'stdout' && sim.onStdoutLine) {
+          sim.onStdoutLine(line);
+        }
+      }
+    });
+  };
+  remember(child.stdout, 'stdout');
+  remember(child.stderr, 'stderr');
+
+  const ready = new Promise((resolve, reject) => {
+    const timer = setTimeout(() => {
+      reject(new CheckFailed(`${name} printed no ready line (http://...) within ${READY_TIMEOUT_MS} ms`));
+    }, READY_TIMEOUT_MS);
+    child.on('error', (err) => {
+      clearTimeout(timer);
+      reject(new CheckFailed(`could not start ${env.simPath}: ${err.message}`));
+    });
+    exited.then(({ code, signal }) => {
+      clearTimeout(timer);
+      reject(new CheckFailed(`${name} exited before it was ready (code ${code}, signal ${signal})`));
+    });
+    sim.onStdoutLine = (line) => {
+      const match = /http:\/\/\S+/.exec(line);
+      if (match) {
+        clearTimeout(timer);
+        sim.onStdoutLine = null;
+        resolve(match[0]);
+      }
+    };
+  });
+  return ready.then((url) => {
+    sim.url = url;
+    log(`${name} ready at ${url}`);
+    return sim;
+  });
+}
+
+// Sends SIGTERM and resolves with { code, signal }; throws if the process is still there after timeoutMs.
+export async function stopSim(sim, timeoutMs) {
+  if (sim.exited) {
+    return sim.exited;
+  }
+  sim.child.kill('SIGTERM');
+  const result = await Promise.race([sim.exitedPromise, sleep(timeoutMs).then(() => null)]);
+  if (result === null) {
+    throw new CheckFailed(`${sim.name} did not exit within ${timeoutMs} ms of SIGTERM`);
+  }
+  return result;
+}
+
+// Stops the sim with SIGTERM and checks that it exited by itself with code 0.
+export async function stopSimCleanly(sim) {
+  const exit = await stopSim(sim, EXIT_TIMEOUT_MS);
+  log(`${sim.name} exited: code ${exit.code}, signal ${exit.signal}`);
+  check(exit.code === 0 && exit.signal === null,
+        `${sim.name} did not exit with code 0 on SIGTERM (code ${exit.code}, signal ${exit.signal})`);
+}
+
+export async function getStatus(sim) {
+  const response = await fetch(new URL('status.json', sim.url), { signal: AbortSignal.timeout(3000) });
+  check(response.ok, `GET status.json answered HTTP ${response.status}`);
+  return response.json();
+}
+
+// The first status.json with an avatar. It may be published a moment after the ready line, so allow a few
+// seconds for it.
+export function firstStatus(sim) {
+  return poll(`status.json of ${sim.name} to report the avatar`, 5000, 100, async () => {
+    const status = await getStatus(sim);
+    return status && status.avatar ? status : null;
+  });
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// The browser: one persistent context in a fresh profile, closed by cleanup.
+// ---------------------------------------------------------------------------------------------------------------
+let context = null;
+let userDataDir = null;
+
+// Launches headless Chromium with a window of viewport { width, height } and resolves with its context.
+export async function launchBrowser(chromium, viewport) {
+  userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'rfbsim-e2e-chromium-'));
+  log(`launching ${CHROMIUM}`);
+  context = await chromium.launchPersistentContext(userDataDir, {
+    executablePath: CHROMIUM,
+    headless: true,
+    args: CHROMIUM_ARGS,
+    viewport,
+    timeout: 30_000,
+  });
+  return context;
+}
+
+// Writes the page's console, uncaught errors, failed requests and HTTP errors to logPath. Returns
+// { pageErrors, badResponses, close() }: the two lists fill as the page runs.
+export function recordPage(page, logPath) {
+  const consoleLog = fs.createWriteStream(logPath);
+  const pageErrors = [];
+  const badResponses = [];
+  page.on('console', (msg) => consoleLog.write(`${msg.type()}: ${msg.text()}\n`));
+  page.on('pageerror', (err) => {
+    pageErrors.push(err.message);
+    consoleLog.write(`pageerror: ${err.message}\n`);
+  });
+  page.on('requestfailed', (req) => consoleLog.write(`requestfailed: ${req.url()} ${req.failure()?.errorText}\n`));
+  page.on('response', (res) => {
+    if (res.status() >= 400) {
+      badResponses.push(`${res.status()} ${res.url()}`);
+      consoleLog.write(`response: HTTP ${res.status()} for ${res.url()}\n`);
+    }
+  });
+  return { pageErrors, badResponses, close: () => consoleLog.end() };
+}
+
+// window.rfbsimState as plain data (null before app.js set it).
+export const pageState = (page) => page.evaluate(() => JSON.parse(JSON.stringify(window.rfbsimState || null)));
+
+// Opens url and resolves with the page's first rfbsimState once app.js has started.
+export async function openPage(page, url) {
+  log(`opening ${url}`);
+  const response = await page.goto(url, { waitUntil: 'load', timeout: 20_000 });
+  check(response && response.ok(), `GET ${url} answered HTTP ${response && response.status()}`);
+  const compatMode = await page.evaluate(() => document.compatMode);
+  check(compatMode === 'CSS1Compat', `page renders in quirks mode (${compatMode})`);
+  // app.js may still be evaluating when 'load' fires (seen with Chromium 156), so wait for its state object.
+  return poll('app.js to start (window.rfbsimState)', 10_000, 100, () => pageState(page));
+}
+
+// Waits until noVNC reports the RFB session up; a disconnect on the way fails at once.
+export async function waitForConnection(page) {
+  await poll('the RFB connection (window.rfbsimState.connected)', 20_000, 200, async () => {
+    const state = await pageState(page);
+    check(state !== null, 'the page did not set window.rfbsimState (app.js not loaded?)');
+    check(!state.lastDisconnect, `the page reports a disconnect: ${state.lastDisconnect?.message}`);
+    return state.connected;
+  });
+  log('noVNC connected');
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Canvas pixels, compared inside the page (no megabytes through the protocol).
+// ---------------------------------------------------------------------------------------------------------------
+
+// Stores the canvas' pixels under `name` and returns simple statistics about them:
+// { ok, width, height, lumaRange (0..255), colours (distinct among every 7th pixel, counted up to 1000) }.
+export function snapshot(page, name) {
+  return page.evaluate((name) => {
+    const canvas = document.querySelector('#screen canvas');
+    if (!canvas || canvas.width === 0 || canvas.height === 0) {
+      return { ok: false, why: 'no canvas, or canvas has no size yet' };
+    }
+    const image = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height);
+    window.__e2eSnapshots = window.__e2eSnapshots || {};
+    window.__e2eSnapshots[name] = image;
+    let minLuma = 255;
+    let maxLuma = 0;
+    const colours = new Set();
+    const d = image.data;
+    for (let i = 0; i < d.length; i += 4 * 7) {
+      const luma = (d[i] * 299 + d[i + 1] * 587 + d[i + 2] * 114) / 1000;
+      minLuma = Math.min(minLuma, luma);
+      maxLuma = Math.max(maxLuma, luma);
+      if (colours.size < 1000) {
+        colours.add((d[i] << 16) | (d[i + 1] << 8) | d[i + 2]);
+      }
+    }
+    return { ok: true, width: canvas.width, height: canvas.height, lumaRange: maxLuma - minLuma,
+             colours: colours.size };
+  }, name);
+}
+
+// Share of pixels (0..1) that differ by more than threshold between two stored snapshots; -1 if they do not
+// both exist at the same size.
+export function changedFraction(page, a, b, threshold) {
+  return page.evaluate(({ a, b, threshold }) => {
+    const A = window.__e2eSnapshots[a];
+    const B = window.__e2eSnapshots[b];
+    if (!A || !B || A.width !== B.width || A.height !== B.height) {
+      return -1;
+    }
+    let changed = 0;
+    for (let i = 0; i < A.data.length; i += 4) {
+      const diff = Math.abs(A.data[i] - B.data[i]) + Math.abs(A.data[i + 1] - B.data[i + 1]) +
+                   Math.abs(A.data[i + 2] - B.data[i + 2]);
+      if (diff > threshold) {
+        changed += 1;
+      }
+    }
+    return changed / (A.width * A.height);
+  }, { a, b, threshold });
+}
+
+// A cols x rows greyscale thumbnail of a stored snapshot: each cell the mean luma (0..255) of its block of
+// pixels, row by row. Returns null if the snapshot does not exist.
+export function thumbnail(page, name, cols, rows) {
+  return page.evaluate(({ name, cols, rows }) => {
+    const image = window.__e2eSnapshots && window.__e2eSnapshots[name];
+    if (!image) {
+      return null;
+    }
+    const sums = new Array(cols * rows).fill(0);
+    const counts = new Array(cols * rows).fill(0);
+    const d = image.data;
+    for (let y = 0; y < image.height; y += 1) {
+      const row = Math.floor((y * rows) / image.height);
+      for (let x = 0; x < image.width; x += 1) {
+        const cell = row * cols + Math.floor((x * cols) / image.width);
+        const i = 4 * (y * image.width + x);
+        sums[cell] += (d[i] * 299 + d[i + 1] * 587 + d[i + 2] * 114) / 1000;
+        counts[cell] += 1;
+      }
+    }
+    return sums.map((sum, cell) => sum / counts[cell]);
+  }, { name, cols, rows });
+}
+
+// Writes the canvas itself (unscaled, no overlays) as a PNG.
+export async function saveCanvasPng(page, file) {
+  const dataUrl = await page.evaluate(() => document.querySelector('#screen canvas').toDataURL('image/png'));
+  fs.writeFileSync(file, Buffer.from(dataUrl.slice(dataUrl.indexOf(',') + 1), 'base64'));
+}
+
+// A picture with content: a real size and more than one colour. Resolves with its snapshot statistics.
+export async function waitForPicture(page, name) {
+  return poll(`a picture with content on the canvas (${name})`, 15_000, 250, async () => {
+    const s = await snapshot(page, name);
+    return s.ok && s.colours > 8 && s.lumaRange > 16 ? s : null;
+  });
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Running a test: overall timeout, interruption, and cleanup always, once, whatever happened.
+// ---------------------------------------------------------------------------------------------------------------
+let cleanupPromise = null;
+
+function cleanup() {
+  if (cleanupPromise) {
+    return cleanupPromise;
+  }
+  cleanupPromise = (async () => {
+    if (context) {
+      await Promise.race([context.close().catch(() => {}), sleep(10_000)]);
+    }
+    for (const sim of sims) {
+      if (!sim.exited) {
+        log(`cleanup: stopping ${sim.name} (pid ${sim.child.pid})`);
+        sim.child.kill('SIGTERM');
+        const gone = await Promise.race([sim.exitedPromise, sleep(3000).then(() => null)]);
+        if (!gone) {
+          sim.child.kill('SIGKILL');
+          await Promise.race([sim.exitedPromise, sleep(2000)]);
+        }
+      }
+      sim.logFile.end();
+    }
+    if (userDataDir) {
+      fs.rmSync(userDataDir, { recursive: true, force: true });
+    }
+  })();
+  return cleanupPromise;
+}
+
+// Last resort when the process ends without cleanup (an uncaught error, EPIPE on a closed stdout): no simulator
+// outlives it, and the browser profile goes. Only synchronous work is possible here.
+process.on('exit', () => {
+  for (const sim of sims) {
+    if (!sim.exited) {
+      sim.child.kill('SIGKILL');
+    }
+  }
+  if (userDataDir) {
+    fs.rmSync(userDataDir, { recursive: true, force: true });
+  }
+});
+
+function printSimTails() {
+  for (const sim of sims) {
+    if (sim.tail.length > 0) {
+      console.error(`--- last output of ${sim.name} (full log: ${sim.logPath}) ---`);
+      console.error(sim.tail.join('\n'));
+    }
+  }
+}
+
+// Runs main() under an overall timeout (RFBSIM_E2E_TIMEOUT_S, else defaultTimeoutS), prints PASS or FAIL,
+// cleans up and exits the process: 0 passed, 1 a check failed or interrupted, 2 overall timeout.
+export async function runTest(testName, defaultTimeoutS, main) {
+  const overallTimeoutMs = 1000 * Number(process.env.RFBSIM_E2E_TIMEOUT_S || defaultTimeoutS);
+  const watchdog = setTimeout(() => {
+    console.error(`FAIL: overall timeout of ${overallTimeoutMs / 1000} s reached`);
+    printSimTails();
+    const hardExit = setTimeout(() => process.exit(2), 15_000);
+    hardExit.unref();
+    cleanup().finally(() => process.exit(2));
+  }, overallTimeoutMs);
+
+  for (const signal of ['SIGINT', 'SIGTERM']) {
+    process.on(signal, () => {
+      console.error(`FAIL: interrupted by ${signal}`);
+      cleanup().finally(() => process.exit(1));
+    });
+  }
+
+  let exitCode = 0;
+  try {
+    await main();
+    log(`PASS: ${testName}`);
+  } catch (err) {
+    exitCode = 1;
+    if (err instanceof CheckFailed) {
+      console.error(`FAIL: ${err.message}`);
+    } else {
+      console.error(`FAIL: unexpected error: ${err && err.stack ? err.stack : err}`);
+    }
+    printSimTails();
+  } finally {
+    await cleanup();
+    clearTimeout(watchdog);
+  }
+  process.exit(exitCode);
+}
