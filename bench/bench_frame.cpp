@@ -4,7 +4,7 @@
 // For each size and case (the avatar walking, turning, or standing still) the simulation is stepped
 // between frames as sim_rfb does at 30 fps, and each frame is timed through:
 //   render    GlRenderer::draw + glFinish (the scene itself is built outside the timer)
-//   readback  OffscreenGL::read_frame (MSAA resolve, glReadPixels, row flip)
+//   readback  OffscreenGL::read_frame (MSAA resolve where multisampled, glReadPixels, row flip)
 //   damage    TileDamage::compare against the previous frame (the server does the same on its thread)
 //   encode    one real libvncserver update: the frame is submitted to an in-process rfbsim::Server with
 //             one libvncclient client connected; we wait until the client has the whole update and read

@@ -8,6 +8,7 @@
 #include <GL/gl.h>
 #include <GL/glext.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <mutex>
@@ -87,13 +88,18 @@ void check_gl(const char* step) {
   }
 }
 
-// The MSAA samples to use. Automatic: 4 on a GPU; none on Mesa's software rasterizers, where 4x MSAA
-// doubled the time of a 720p frame of the warehouse (bench_world) and the resolve alone took 6 ms.
-int chosen_samples(int requested, const char* gl_renderer) {
-  if (requested != OffscreenGLOptions::kAutoSamples) return requested > 1 ? requested : 0;
-  const std::string name = gl_renderer != nullptr ? gl_renderer : "";
-  const bool software = name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos;
-  return software ? 0 : 4;
+// The MSAA samples to use, at most `most` (GL_MAX_SAMPLES). Automatic: 4 on a GPU; none on Mesa's software
+// rasterizers, where 4x MSAA doubled the time of a 720p frame of the warehouse (bench_world) and the
+// resolve alone took 6 ms.
+int chosen_samples(int requested, const char* gl_renderer, int most) {
+  int samples = requested;
+  if (requested == OffscreenGLOptions::kAutoSamples) {
+    const std::string name = gl_renderer != nullptr ? gl_renderer : "";
+    const bool software = name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos;
+    samples = software ? 0 : 4;
+  }
+  samples = std::min(samples, most);
+  return samples > 1 ? samples : 0;
 }
 
 }  // namespace
@@ -106,8 +112,8 @@ struct OffscreenGL::Impl {
   std::string platform;
   int samples = 0;                       // MSAA samples in use, 0 = none
   GLuint draw_fbo = 0;                   // multisampled when samples > 0
-  GLuint resolve_fbo = 0;                // single-sampled copy read back to the CPU
-  GLuint renderbuffers[3] = {0, 0, 0};   // draw colour, draw depth, resolve colour
+  GLuint resolve_fbo = 0;                // single-sampled copy read back to the CPU; only when samples > 0
+  GLuint renderbuffers[3] = {0, 0, 0};   // draw colour, draw depth, resolve colour (only when samples > 0)
   std::vector<std::uint8_t> bottom_up;   // glReadPixels output
   std::vector<std::uint8_t> top_down;    // what read_frame() hands out
 
@@ -153,10 +159,11 @@ void OffscreenGL::Impl::create_context() {
 void OffscreenGL::Impl::create_framebuffers() {
   const int w = options.width;
   const int h = options.height;
-  samples = chosen_samples(options.samples, reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
-  glGenRenderbuffers(3, renderbuffers);
+  GLint most_samples = 0;
+  glGetIntegerv(GL_MAX_SAMPLES, &most_samples);
+  samples = chosen_samples(options.samples, reinterpret_cast<const char*>(glGetString(GL_RENDERER)), most_samples);
+  glGenRenderbuffers(samples > 0 ? 3 : 2, renderbuffers);
   glGenFramebuffers(1, &draw_fbo);
-  glGenFramebuffers(1, &resolve_fbo);
 
   glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers[0]);
   glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
@@ -168,12 +175,16 @@ void OffscreenGL::Impl::create_framebuffers() {
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
     throw std::runtime_error("the drawing framebuffer is incomplete");
   }
-  glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers[2]);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
-  glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, renderbuffers[2]);
-  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-    throw std::runtime_error("the read-back framebuffer is incomplete");
+  // A multisampled picture is resolved into a plain one before it is read; a plain one is read directly.
+  if (samples > 0) {
+    glGenFramebuffers(1, &resolve_fbo);
+    glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers[2]);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, renderbuffers[2]);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw std::runtime_error("the read-back framebuffer is incomplete");
+    }
   }
   check_gl("framebuffer creation");
   const auto bytes = static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4U;

@@ -3,13 +3,10 @@
 #include "render/draw_batches.hpp"
 
 #include <algorithm>
-#include <array>
 
 namespace rfbsim::sim {
 
 namespace {
-
-constexpr std::array<Shape, 4> kShapes{Shape::Box, Shape::Sphere, Shape::Cylinder, Shape::Disc};
 
 // Appends the batches of `indices` (already in drawing order), one per run of equal shapes.
 void append_runs(DrawPlan& plan, const Scene& scene, const std::vector<std::uint32_t>& indices, bool blended) {
@@ -45,9 +42,7 @@ DrawPlan plan_draws(const Scene& scene) {
   for (const std::uint32_t i : standing) {
     distance[i] = (items[i].model.translation() - scene.camera.eye).squaredNorm();
   }
-  const auto shape_rank = [](Shape shape) {
-    return std::find(kShapes.begin(), kShapes.end(), shape) - kShapes.begin();
-  };
+  const auto shape_rank = [](Shape shape) { return static_cast<int>(shape); };  // Box, Sphere, Cylinder, Disc
   std::stable_sort(standing.begin(), standing.end(), [&](std::uint32_t a, std::uint32_t b) {
     const auto ra = shape_rank(items[a].shape);
     const auto rb = shape_rank(items[b].shape);

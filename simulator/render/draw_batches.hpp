@@ -19,6 +19,7 @@ struct DrawBatch {
   bool blended = false;  ///< translucent: blended over what is drawn, without writing depth
 };
 
+/// How to draw a scene: its items' order and the batches that order is cut into.
 struct DrawPlan {
   std::vector<std::uint32_t> order;  ///< indices into Scene::items, in drawing order
   std::vector<DrawBatch> batches;    ///< cover `order` exactly, in drawing order

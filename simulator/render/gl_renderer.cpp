@@ -15,6 +15,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "render/draw_batches.hpp"
@@ -88,6 +89,7 @@ struct InstanceAttributes {
   float surface;                        // Surface as a number
 };
 static_assert(sizeof(InstanceAttributes) == 30 * sizeof(float), "instance attributes must be tightly packed");
+static_assert(std::is_standard_layout_v<InstanceAttributes>, "offsetof needs a standard-layout type");
 
 constexpr GLuint kInstanceFirstLocation = 2;
 
@@ -241,8 +243,11 @@ void GlRenderer::draw(const Scene& scene, int width, int height) {
   glViewport(0, 0, width, height);
   glClearColor(scene.sky.x(), scene.sky.y(), scene.sky.z(), 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  // The state every batch starts from, whatever the context was left with.
   glEnable(GL_DEPTH_TEST);
   glEnable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
   glUseProgram(impl_->program);
 
   const float aspect = static_cast<float>(width) / static_cast<float>(height);

@@ -59,11 +59,27 @@ TEST_CASE("automatic MSAA is off on a software rasterizer and 4x on a GPU; an ex
   CHECK(automatic.samples() == (software ? 0 : 4));
   CHECK(rfbsim::OffscreenGL({64, 64, 4, "auto"}).samples() == 4);
   CHECK(rfbsim::OffscreenGL({64, 64, 1, "auto"}).samples() == 0);
-  // Without multisampling the picture is read straight from the drawing framebuffer.
-  automatic.begin_frame();
+  // More than the renderer can do is its most, not a broken framebuffer.
+  rfbsim::OffscreenGL greedy({64, 64, 1024, "auto"});
+  GLint most = 0;
+  glGetIntegerv(GL_MAX_SAMPLES, &most);
+  CHECK(greedy.samples() == (most > 1 ? most : 0));
+}
+
+TEST_CASE("without multisampling the picture is read straight from the drawing framebuffer") {
+  rfbsim::OffscreenGL plain({64, 64, 0, "auto"});
+  REQUIRE(plain.samples() == 0);
+  plain.begin_frame();
   glClearColor(1.0f, 0.0f, 0.0f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
-  CHECK(pixel(automatic.read_frame(), 3, 60) == std::array<int, 4>{255, 0, 0, 255});
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(0, 60, 4, 4);  // GL's top rows: the frame's first rows
+  glClearColor(0.0f, 1.0f, 0.0f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  glDisable(GL_SCISSOR_TEST);
+  const rfbsim::FrameView frame = plain.read_frame();
+  CHECK(pixel(frame, 1, 1) == std::array<int, 4>{0, 255, 0, 255});
+  CHECK(pixel(frame, 3, 60) == std::array<int, 4>{255, 0, 0, 255});
 }
 
 TEST_CASE("the demo scene renders sky above and the avatar's blue shirt at the centre") {

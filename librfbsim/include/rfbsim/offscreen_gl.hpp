@@ -13,12 +13,14 @@ namespace rfbsim {
 
 /// Definition of an off-screen context.
 struct OffscreenGLOptions {
+  /// `samples` value that lets OffscreenGL choose the MSAA for the renderer it finds.
   static constexpr int kAutoSamples = -1;
 
   int width = 1280;   ///< FBO width in pixels (> 0)
   int height = 720;   ///< FBO height in pixels (> 0)
-  /// MSAA samples (resolved before read-back); 0 or 1 = none. kAutoSamples: 4 on a GPU, none on a
-  /// software rasterizer (Mesa llvmpipe or softpipe), where 4x MSAA costs more than the rest of the frame.
+  /// MSAA samples (resolved before read-back); 0 or 1 = none; more than the renderer supports
+  /// (GL_MAX_SAMPLES) = its maximum. kAutoSamples: 4 on a GPU, none on a software rasterizer (Mesa
+  /// llvmpipe or softpipe), where 4x MSAA costs more than the rest of the frame.
   int samples = kAutoSamples;
   /// Which EGL platform to use: "auto" tries the device platform (GPUs, e.g. NVIDIA) and then Mesa's
   /// surfaceless platform (llvmpipe on machines without a GPU); or "device" / "surfaceless".
