@@ -112,6 +112,7 @@ void bench_render(const Options& options) {
     std::vector<double> build_ms;
     std::vector<double> draw_ms;
     std::vector<double> readback_ms;
+    std::vector<double> frame_ms;  // the three together: what one frame costs sim_rfb's thread
     std::size_t items = 0;
     std::size_t draw_calls = 0;
     for (int frame = 0; frame < options.frames + 10; ++frame) {
@@ -134,6 +135,7 @@ void bench_render(const Options& options) {
       build_ms.push_back(bench::ms_between(t0, t1));
       draw_ms.push_back(bench::ms_between(t1, t2));
       readback_ms.push_back(bench::ms_between(t2, t3));
+      frame_ms.push_back(bench::ms_between(t0, t3));
     }
     const auto row = [&](const char* stage, const std::vector<double>& samples) {
       const bench::Summary s = bench::summarize(samples);
@@ -143,6 +145,7 @@ void bench_render(const Options& options) {
     row("build scene", build_ms);
     row("render", draw_ms);
     row("read back", readback_ms);
+    row("whole frame", frame_ms);
   }
   table.print();
 }

@@ -44,13 +44,37 @@ constexpr std::uint32_t kShirts[] = {0x8a5a9e, 0x3f6fb5, 0xb5473f, 0x4f8f4a, 0xc
 
 constexpr double kSpawnGap = 0.15;  // m kept between bodies and from walls at spawn
 
-// Whether someone other than `self` stands on `point`: their centre within two body radii (0.5 m) of it.
-bool taken_by_other(const Eigen::Vector2d& point, const std::vector<Neighbour>& bodies, std::size_t self) {
-  constexpr double kStandingOn = 0.5;
+// Whether someone other than `self` stands so near `point` that `self` could not stand there without
+// touching them (keeping `gap`).
+bool taken_by_other(const Eigen::Vector2d& point, const std::vector<Neighbour>& bodies, std::size_t self,
+                    double gap) {
   for (std::size_t j = 0; j < bodies.size(); ++j) {
-    if (j != self && (bodies[j].position - point).squaredNorm() < kStandingOn * kStandingOn) return true;
+    const double apart = bodies[self].radius + bodies[j].radius + gap;
+    if (j != self && (bodies[j].position - point).squaredNorm() < apart * apart) return true;
   }
   return false;
+}
+
+// `v` (self's velocity) with its speed toward each nearby body limited to what still lets self stop
+// `gap` short of it, braking at `braking`: people walk around, away from or up to whoever is near, never
+// into them. The limit is on self's own speed, not the speed relative to the other: a pushed robot moves
+// away as fast as it is pushed, and a relative limit would let the push go on.
+Eigen::Vector2d keep_off_bodies(Eigen::Vector2d v, const std::vector<Neighbour>& bodies, std::size_t self,
+                                double gap, double braking) {
+  constexpr double kLookAhead = 1.0;  // m of gap within which the limit applies
+  const Neighbour& me = bodies[self];
+  for (std::size_t j = 0; j < bodies.size(); ++j) {
+    if (j == self) continue;
+    const Eigen::Vector2d d = bodies[j].position - me.position;
+    const double distance = d.norm();
+    const double free = distance - me.radius - bodies[j].radius - gap;
+    if (distance < 1e-9 || free >= kLookAhead) continue;
+    const Eigen::Vector2d toward = d / distance;
+    const double closing = v.dot(toward);
+    const double allowed = std::sqrt(2.0 * braking * std::max(0.0, free));
+    if (closing > allowed) v -= (closing - allowed) * toward;
+  }
+  return v;
 }
 
 }  // namespace
@@ -60,7 +84,22 @@ Crowd::Crowd(const World& world, CrowdSpec spec, SocialForceParams params)
   const std::size_t count = static_cast<std::size_t>(std::max(0, spec_.count));
   walkers_.resize(count);
   spawned_.reserve(count);
-  for (std::size_t i = 0; i < count; ++i) place(i, spawned_);
+  const std::vector<Neighbour> standing = avatar_and_robot(world);
+  for (std::size_t i = 0; i < count; ++i) place(i, standing, spawned_);
+}
+
+std::vector<Neighbour> Crowd::avatar_and_robot(const World& world) const {
+  std::vector<Neighbour> bodies;
+  if (params_.react_to_avatar) {
+    const Avatar& a = world.avatar;
+    const Eigen::Vector2d heading(std::cos(a.pose.yaw), std::sin(a.pose.yaw));
+    bodies.push_back({{a.pose.x, a.pose.y}, a.speed * heading, a.radius});
+  }
+  if (params_.react_to_robot && world.robot) {
+    const Robot& r = *world.robot;
+    bodies.push_back({{r.pose.x, r.pose.y}, r.velocity, r.radius});
+  }
+  return bodies;
 }
 
 std::vector<Person> Crowd::spawn() const { return spawned_; }
@@ -82,7 +121,7 @@ Eigen::Vector2d Crowd::random_free_point(std::mt19937_64& rng) const {
   return m.cell_centre({m.width / 2, m.height / 2});
 }
 
-void Crowd::place(std::size_t index, std::vector<Person>& placed) {
+void Crowd::place(std::size_t index, const std::vector<Neighbour>& standing, std::vector<Person>& placed) {
   Walker& w = walkers_[index];
   w.rng.seed(splitmix64(spec_.seed ^ splitmix64(static_cast<std::uint64_t>(index))));
   Person p;
@@ -97,7 +136,10 @@ void Crowd::place(std::size_t index, std::vector<Person>& placed) {
   const GridMap& m = planner_.map();
   const auto clear = [&](const Eigen::Vector2d& q) {
     if (m.disc_hits_wall(q.x(), q.y(), p.radius + kSpawnGap)) return false;
-    return std::all_of(placed.begin(), placed.end(), [&](const Person& o) {
+    const bool clear_of_standing = std::all_of(standing.begin(), standing.end(), [&](const Neighbour& o) {
+      return (o.position - q).norm() >= p.radius + o.radius + kSpawnGap;
+    });
+    return clear_of_standing && std::all_of(placed.begin(), placed.end(), [&](const Person& o) {
       return std::hypot(o.pose.x - q.x(), o.pose.y - q.y()) >= p.radius + o.radius + kSpawnGap;
     });
   };
@@ -192,7 +234,8 @@ Eigen::Vector2d Crowd::desired_direction(Walker& w, const Person& person, const 
   double distance = (w.waypoints[w.next] - here).norm();
   const bool last = w.next + 1 == w.waypoints.size();
   if (last && (distance < params_.goal_radius ||
-               (distance < params_.taken_goal_radius && taken_by_other(w.waypoints[w.next], bodies, self)))) {
+               (distance < params_.taken_goal_radius &&
+                taken_by_other(w.waypoints[w.next], bodies, self, params_.min_body_gap)))) {
     if (single_point) return Eigen::Vector2d::Zero();  // stands at (or next to) its only point
     ++w.goals_reached;
     choose_next_goal(w);
@@ -226,15 +269,10 @@ void Crowd::step(World& world, double dt) {
   std::vector<Neighbour>& now = bodies_;
   now.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    now[i] = {{world.people[i].pose.x, world.people[i].pose.y}, world.people[i].velocity};
+    const Person& p = world.people[i];
+    now[i] = {{p.pose.x, p.pose.y}, p.velocity, p.radius};
   }
-  if (params_.react_to_avatar) {
-    const Avatar& a = world.avatar;
-    now.push_back({{a.pose.x, a.pose.y}, a.speed * Eigen::Vector2d(std::cos(a.pose.yaw), std::sin(a.pose.yaw))});
-  }
-  if (params_.react_to_robot && world.robot) {
-    now.push_back({{world.robot->pose.x, world.robot->pose.y}, world.robot->velocity});
-  }
+  for (const Neighbour& body : avatar_and_robot(world)) now.push_back(body);
   const DistanceField& field = planner_.field();
   for (std::size_t i = 0; i < n; ++i) {
     Person& person = world.people[i];
@@ -247,6 +285,7 @@ void Crowd::step(World& world, double dt) {
 
     // Semi-implicit Euler: the new velocity is what moves the body this tick.
     Eigen::Vector2d v = cap_speed(now[i].velocity + dt * force, person.desired_speed, params_);
+    v = keep_off_bodies(v, now, i, params_.min_body_gap, params_.body_braking);
     // Without physics nothing stops a body at a wall: drop the part of v that would bring it too near.
     const Eigen::Vector2d next = now[i].position + dt * v;
     if (field.at(next.x(), next.y()) < params_.min_wall_gap) {

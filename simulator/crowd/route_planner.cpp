@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// RoutePlanner: A* on the obstacle grid within a clearance, then line-of-sight pruning to a few waypoints.
+// RoutePlanner: A* over blocks of the obstacle grid within a clearance, then line-of-sight pruning to a few
+// waypoints.
 #include "crowd/route_planner.hpp"
 
 #include <algorithm>
@@ -15,10 +16,27 @@ namespace {
 
 constexpr std::size_t kNoParent = std::numeric_limits<std::size_t>::max();
 
+// The cells of a k x k block as offsets from its lower-left corner, nearest the block's middle first
+// (ties in row, then column order).
+std::vector<Cell> middle_first_offsets(int k) {
+  std::vector<Cell> offsets;
+  for (int row = 0; row < k; ++row) {
+    for (int col = 0; col < k; ++col) offsets.push_back({col, row});
+  }
+  const double middle = 0.5 * (k - 1);
+  std::stable_sort(offsets.begin(), offsets.end(), [middle](Cell a, Cell b) {
+    return std::hypot(a.col - middle, a.row - middle) < std::hypot(b.col - middle, b.row - middle);
+  });
+  return offsets;
+}
+
 }  // namespace
 
 RoutePlanner::RoutePlanner(const GridMap& obstacles, RoutePlannerParams params)
-    : field_(obstacles), params_(params) {}
+    : field_(obstacles),
+      params_(params),
+      block_(std::max(1, static_cast<int>(std::lround(params.search_step / obstacles.resolution)))),
+      block_offsets_(middle_first_offsets(block_)) {}
 
 bool RoutePlanner::walkable(Cell c, double clearance) const {
   // at_cell is centre to centre; the nearest wall's surface is half a cell nearer.
@@ -61,11 +79,11 @@ std::vector<Cell> RoutePlanner::search(Cell start, Cell goal, double clearance) 
   };
   if (!open_cell(start) || !open_cell(goal)) return {};
 
-  // Nodes: blocks of k x k cells, each stood for by its middle cell, except that the start's block is
-  // stood for by the start; one more node is the goal itself. A 20 x 30 m map at 0.05 m has 240 000 cells
-  // but 15 000 blocks of 0.2 m, which makes a route across it some 15 times cheaper to find, and a person
-  // needs no finer steps: the route is straightened afterwards on the cells themselves.
-  const int k = std::max(1, static_cast<int>(std::lround(params_.search_step / res)));
+  // Nodes: blocks of k x k cells, each stood for by one of its open cells, except that the start's block
+  // is stood for by the start; one more node is the goal itself. A 20 x 30 m map at 0.05 m has 240 000
+  // cells but 15 000 blocks of 0.2 m, which makes a route across it some 15 times cheaper to find, and a
+  // person needs no finer steps: the route is straightened afterwards on the cells themselves.
+  const int k = block_;
   const int blocks_x = (m.width + k - 1) / k;
   const int blocks_y = (m.height + k - 1) / k;
   const std::size_t blocks = static_cast<std::size_t>(blocks_x) * static_cast<std::size_t>(blocks_y);
@@ -74,32 +92,52 @@ std::vector<Cell> RoutePlanner::search(Cell start, Cell goal, double clearance) 
     return static_cast<std::size_t>(by) * static_cast<std::size_t>(blocks_x) + static_cast<std::size_t>(bx);
   };
   const std::size_t start_node = node_of_block(start.col / k, start.row / k);
+  // A block's stand-in is its open cell nearest the block's middle (scan order breaks ties), found on first
+  // use: a passage narrower than a block still counts wherever it falls. A block without one is stood for
+  // by its corner cell, which is not open, so the search never enters it.
+  std::vector<Cell> stand_in(blocks, Cell{-1, -1});
   const auto cell_of_node = [&](std::size_t node) {
     if (node == goal_node) return goal;
     if (node == start_node) return start;
-    const int bx = static_cast<int>(node % static_cast<std::size_t>(blocks_x));
-    const int by = static_cast<int>(node / static_cast<std::size_t>(blocks_x));
-    return Cell{std::min(bx * k + k / 2, m.width - 1), std::min(by * k + k / 2, m.height - 1)};
+    Cell& cached = stand_in[node];
+    if (cached.col < 0) {
+      const Cell corner{static_cast<int>(node % static_cast<std::size_t>(blocks_x)) * k,
+                        static_cast<int>(node / static_cast<std::size_t>(blocks_x)) * k};
+      cached = corner;
+      for (const Cell& offset : block_offsets_) {
+        const Cell c{corner.col + offset.col, corner.row + offset.row};
+        if (c.col < m.width && c.row < m.height && open_cell(c)) {
+          cached = c;
+          break;
+        }
+      }
+    }
+    return cached;
   };
 
-  // A step between two open node cells. Between neighbouring cells (k = 1), a diagonal step must not cut
-  // a corner. Longer steps need every cell on the segment open, except when the clearance alone rules
-  // out a wall on it: the distance to walls changes by at most the distance moved, so a segment whose
-  // ends keep `clearance` (the start and goal need not) keeps clearance - length / 2 everywhere, more
-  // than a cell when the clearance is large enough.
+  // A step between two open node cells: every cell on the segment must be open too, and where the segment
+  // moves diagonally from one cell to the next, both cells beside that corner, so that no step slips
+  // between two walls that touch at a corner. A step far from walls skips the check: the distance to walls
+  // changes by at most the distance moved, so if both ends keep clearance + length / 2 (plus a cell for
+  // the grid), every point between keeps the clearance.
   const auto step_open = [&](Cell a, Cell b) {
     const int dc = b.col - a.col;
     const int dr = b.row - a.row;
-    if (std::abs(dc) <= 1 && std::abs(dr) <= 1) {
-      return dc == 0 || dr == 0 || (open_cell({a.col + dc, a.row}) && open_cell({a.col, a.row + dr}));
-    }
     const double length = res * std::hypot(dc, dr);
-    if (clearance >= 0.5 * length + res && walkable(a, clearance) && walkable(b, clearance)) return true;
+    const double roomy = clearance + 0.5 * length + res;
+    if (field_.at_cell(a) - 0.5 * res >= roomy && field_.at_cell(b) - 0.5 * res >= roomy) return true;
     const int samples = static_cast<int>(std::ceil(2.0 * std::hypot(dc, dr)));  // every half cell
-    for (int i = 1; i < samples; ++i) {
+    Cell previous = a;
+    for (int i = 1; i <= samples; ++i) {
       const double t = static_cast<double>(i) / samples;
       const Cell c{a.col + static_cast<int>(std::lround(t * dc)), a.row + static_cast<int>(std::lround(t * dr))};
+      if (c == previous) continue;
       if (!open_cell(c)) return false;
+      if (c.col != previous.col && c.row != previous.row &&
+          (!open_cell({c.col, previous.row}) || !open_cell({previous.col, c.row}))) {
+        return false;
+      }
+      previous = c;
     }
     return true;
   };

@@ -48,6 +48,8 @@ class RoutePlanner {
   [[nodiscard]] std::vector<Cell> search(Cell start, Cell goal, double clearance) const;
   DistanceField field_;
   RoutePlannerParams params_;
+  int block_ = 1;                   // cells per side of the search's blocks
+  std::vector<Cell> block_offsets_;  // a block's cells, nearest its middle first
 };
 
 }  // namespace rfbsim::sim

@@ -67,20 +67,31 @@ struct SocialForceParams {
   // Walking behaviour (rfbsim choices).
   double goal_radius = 0.3;       ///< m: a goal counts as reached this near (PySocialForce: 0.2)
   double waypoint_radius = 0.6;   ///< m: an intermediate waypoint counts as reached this near
-  /// m: a goal that someone else stands on (their centre within 0.5 m of it) counts as reached this near,
-  /// so that people do not shove a standing robot, the avatar or another person off their spot
+  /// m: a goal that someone else stands on (so near that the person could not stand there without touching
+  /// them) counts as reached this near, so that people do not shove a standing robot, the avatar or
+  /// another person off their spot
   double taken_goal_radius = 1.0;
+  /// m: the gap a person keeps from every other body. Closing in on one, a person slows so as to stop this
+  /// far from it (walking around or away stays free), so that people never shove the robot, the avatar or
+  /// each other; the physics would let them.
+  double min_body_gap = 0.05;
+  /// m/s^2: the braking people plan with when closing in on a body; below what their legs can do in the
+  /// physics (PhysicsParams::person_drive_force / person_mass, 4.3 m/s^2), so that they can always stop.
+  double body_braking = 3.0;
   double clearance = 0.3;         ///< m: routes keep the body centre this far from walls (radius + 5 cm)
   double turn_rate = 4.0;         ///< rad/s: how fast the body turns toward the way it walks
   double stall_time = 4.0;        ///< s: no progress toward the waypoint for this long => re-plan
-  bool react_to_avatar = true;    ///< the participant's avatar repels people like a person
-  bool react_to_robot = true;     ///< the robot repels people like a person
+  /// The participant's avatar repels people like a person, and people keep min_body_gap from it, do not
+  /// spawn on it and give up a goal it stands on.
+  bool react_to_avatar = true;
+  bool react_to_robot = true;     ///< the same for the robot
 };
 
 /// What the social force needs to know of another body.
 struct Neighbour {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< m
   Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< m/s
+  double radius = 0.25;                                ///< m, body radius
 };
 
 /// Goal force (v0 e - v) / tau, m/s^2; `direction` is a unit vector (zero to stop where it stands).

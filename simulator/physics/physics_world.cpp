@@ -142,7 +142,7 @@ PhysicsWorld::Impl::Impl(const World& w, PhysicsParams p)
   // The avatar starts with its current speed, so a walking avatar does not stumble when physics begins.
   const Avatar& a = w.avatar;
   const Eigen::Vector2d heading(std::cos(a.pose.yaw), std::sin(a.pose.yaw));
-  avatar = make_body(a.pose.x, a.pose.y, a.speed * heading, params.avatar_radius, params.avatar_height,
+  avatar = make_body(a.pose.x, a.pose.y, a.speed * heading, a.radius, params.avatar_height,
                      params.person_mass, true);
   sync_agents(w);
 }

@@ -12,7 +12,6 @@ namespace rfbsim::sim {
 
 /// Physical constants of the bodies and contacts; the defaults are tuned for a 60 Hz tick.
 struct PhysicsParams {
-  double avatar_radius = 0.3;          ///< m, as AvatarParams::radius
   double avatar_height = 1.75;         ///< m
   double avatar_stride_length = 1.4;   ///< m per gait cycle, as AvatarParams::stride_length
   double person_mass = 70.0;           ///< kg, the avatar and each person

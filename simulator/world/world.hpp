@@ -89,6 +89,7 @@ struct Avatar {
   double yaw_rate = 0.0;      ///< rad/s
   double gait_phase = 0.0;    ///< radians of the walking cycle, advances with distance walked
   double distance_walked = 0.0;  ///< m, total
+  double radius = 0.3;        ///< m, body radius for contacts (physics) and for people keeping clear of it
 };
 
 /// The third-person camera's adjustable part; where it is follows from the avatar each frame.

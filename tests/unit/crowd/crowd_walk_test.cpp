@@ -49,19 +49,22 @@ TEST_CASE("two people walking head-on pass without touching and both arrive") {
   WARN("head-on: closest centre distance " << closest << " m");
 }
 
-TEST_CASE("Helbing-Molnar 1995 lets an exact head-on pair walk into each other (why Moussaid is the default)") {
+TEST_CASE("Helbing-Molnar 1995 has an exact head-on pair meet face to face (why Moussaid is the default)") {
   World world = walled_world(20.0, 10.0, 0.25);
   SocialForceParams params;
   params.model = PedestrianModel::HelbingMolnar1995;
   Crowd crowd = walkers_to(world, {{3, 5}, {17, 5}}, {{17, 5}, {3, 5}}, params);
   double closest = 1e9;
+  double sideways = 0.0;
   for (int t = 0; t < 60 * 25; ++t) {
     tick(crowd, world, 1.0 / 60.0);
     closest = std::min(closest, distance(world.people[0], world.people[1]));
+    for (const Person& p : world.people) sideways = std::max(sideways, std::abs(p.pose.y - 5.0));
   }
-  // Forces along the line between them only: nobody steps aside, and the bodies overlap (without physics
-  // they then squeeze through each other).
-  CHECK(closest < world.people[0].radius + world.people[1].radius);
+  // Forces along the line between them only: nobody steps aside, so they meet chest to chest (they do not
+  // walk into each other: one backs off as the other presses on).
+  CHECK(sideways < 0.01);
+  CHECK(closest < world.people[0].radius + world.people[1].radius + 0.1);
 }
 
 TEST_CASE("a 2.5 m corridor with ten people going both ways keeps flowing for two minutes") {

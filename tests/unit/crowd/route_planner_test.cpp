@@ -131,3 +131,30 @@ TEST_CASE("on a fine map the route goes through the door of a wall one cell thic
   CHECK(closed.plan({1.0, 1.0}, {5.0, 1.0}, 0.3).waypoints.empty());
   CHECK(closed.plan({2.9, 1.0}, {3.1, 1.0}, 0.3).waypoints.empty());
 }
+
+TEST_CASE("a door 0.75 m or wider keeps the full clearance wherever it falls on the search's blocks") {
+  // 6 m x 4 m at 0.05 m, a wall 0.2 m thick at x = 2.9..3.1 with a door 0.65..0.9 m wide, shifted by whole
+  // cells against the 4 x 4 blocks the search steps between. At the full 0.3 m clearance only the middle of
+  // a 0.65 m door is walkable, one cell wide, and the blocks' stand-ins do not always line up along it:
+  // such a door is passed at half the clearance. From 0.75 m on, the walkable strip is wide enough.
+  for (const int width_cells : {13, 14, 15, 16, 17, 18}) {
+    for (int shift = 0; shift < 4; ++shift) {
+      const int first_open_row = 30 + shift;
+      const RoutePlanner planner(bordered_map(120, 80, 0.05, [&](int col, int row) {
+        return col >= 58 && col < 62 && !(row >= first_open_row && row < first_open_row + width_cells);
+      }));
+      INFO("door " << width_cells * 5 << " cm wide from row " << first_open_row);
+      const PlannedRoute route = planner.plan({1.0, 1.0}, {5.0, 1.0}, 0.3);
+      REQUIRE(!route.waypoints.empty());
+      CHECK(route.clearance >= (width_cells >= 15 ? 0.3 : 0.15));
+      check_legs_clear(planner, {1.0, 1.0}, route);
+    }
+  }
+}
+
+TEST_CASE("no step slips between wall cells that touch at a corner, even at no clearance") {
+  // A one-cell wall as a 45 degree staircase from corner to corner of a 4 m square at 0.05 m.
+  const RoutePlanner planner(bordered_map(80, 80, 0.05, [](int col, int row) { return col + row == 79; }));
+  CHECK(planner.plan({1.0, 1.0}, {3.0, 3.0}, 0.3).waypoints.empty());
+  CHECK(planner.plan({1.8, 1.8}, {2.2, 2.2}, 0.0).waypoints.empty());
+}
