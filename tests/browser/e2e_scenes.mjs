@@ -121,7 +121,7 @@ async function showScene(context, scene) {
   e2e.check(recorder.pageErrors.length === 0,
             `${name}: uncaught errors in the page: ${recorder.pageErrors.join(' | ')}`);
   await page.close();
-  recorder.close();
+  await recorder.close();
   return { name, status: status0, picture, motion, laterFraction, drift, thumbnail: thumb };
 }
 

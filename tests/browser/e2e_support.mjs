@@ -48,6 +48,27 @@ export function check(condition, message) {
 
 export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
+const STREAM_END_TIMEOUT_MS = 2000;   // a log file gets this long to be written out when it is closed
+
+// Ends a write stream and resolves once what was written reached the file (or it failed, or after
+// STREAM_END_TIMEOUT_MS). Calling it again is harmless and waits the same way.
+function endStream(stream) {
+  return new Promise((resolve) => {
+    const timer = setTimeout(resolve, STREAM_END_TIMEOUT_MS);
+    stream.end(() => {
+      clearTimeout(timer);
+      resolve();
+    });
+  });
+}
+
+// Writes to a log stream unless it was closed already (late output after cleanup must not throw).
+function writeLog(stream, data) {
+  if (!stream.writableEnded) {
+    stream.write(data);
+  }
+}
+
 // Resolves with fn()'s first truthy value, polling every intervalMs; throws CheckFailed after timeoutMs.
 // A CheckFailed thrown by fn ends the wait at once; other errors (a refused fetch, say) are retried.
 export async function poll(what, timeoutMs, intervalMs, fn) {
@@ -129,12 +150,17 @@ export function startSim(env, name, args) {
     });
   });
   sim.exitedPromise = exited;
+  // 'close' comes after 'exit' once stdout and stderr are read to the end: the last lines are in the log then.
+  sim.closedPromise = new Promise((resolve) => {
+    child.on('close', resolve);
+    child.on('error', resolve);
+  });
 
   // Keep the last lines of output for failure messages; everything goes to the log file.
   const remember = (stream, label) => {
     let partial = '';
     stream.on('data', (chunk) => {
-      logFile.write(chunk);
+      writeLog(logFile, chunk);
       partial += chunk.toString('utf8');
       const lines = partial.split('\n');
       partial = lines.pop();
@@ -221,9 +247,14 @@ export function firstStatus(sim) {
 // ---------------------------------------------------------------------------------------------------------------
 let context = null;
 let userDataDir = null;
+const consoleLogs = [];   // every log stream recordPage opened, for cleanup
 
 // Launches headless Chromium with a window of viewport { width, height } and resolves with its context.
+// Once per test: cleanup knows one browser, so a second call throws rather than leak the first and its profile.
 export async function launchBrowser(chromium, viewport) {
+  if (userDataDir !== null) {
+    throw new Error('launchBrowser called a second time: a test has one browser; use the context it returned');
+  }
   userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'rfbsim-e2e-chromium-'));
   log(`launching ${CHROMIUM}`);
   context = await chromium.launchPersistentContext(userDataDir, {
@@ -232,29 +263,35 @@ export async function launchBrowser(chromium, viewport) {
     args: CHROMIUM_ARGS,
     viewport,
     timeout: 30_000,
+    // runTest handles these: playwright's own SIGINT handler would exit 130 before cleanup stopped the sims.
+    handleSIGINT: false,
+    handleSIGTERM: false,
   });
   return context;
 }
 
 // Writes the page's console, uncaught errors, failed requests and HTTP errors to logPath. Returns
-// { pageErrors, badResponses, close() }: the two lists fill as the page runs.
+// { pageErrors, badResponses, close() }: the two lists fill as the page runs; close() resolves once the log is
+// written out. Cleanup closes it too, if the test did not get that far.
 export function recordPage(page, logPath) {
   const consoleLog = fs.createWriteStream(logPath);
+  consoleLogs.push(consoleLog);
+  const write = (line) => writeLog(consoleLog, `${line}\n`);
   const pageErrors = [];
   const badResponses = [];
-  page.on('console', (msg) => consoleLog.write(`${msg.type()}: ${msg.text()}\n`));
+  page.on('console', (msg) => write(`${msg.type()}: ${msg.text()}`));
   page.on('pageerror', (err) => {
     pageErrors.push(err.message);
-    consoleLog.write(`pageerror: ${err.message}\n`);
+    write(`pageerror: ${err.message}`);
   });
-  page.on('requestfailed', (req) => consoleLog.write(`requestfailed: ${req.url()} ${req.failure()?.errorText}\n`));
+  page.on('requestfailed', (req) => write(`requestfailed: ${req.url()} ${req.failure()?.errorText}`));
   page.on('response', (res) => {
     if (res.status() >= 400) {
       badResponses.push(`${res.status()} ${res.url()}`);
-      consoleLog.write(`response: HTTP ${res.status()} for ${res.url()}\n`);
+      write(`response: HTTP ${res.status()} for ${res.url()}`);
     }
   });
-  return { pageErrors, badResponses, close: () => consoleLog.end() };
+  return { pageErrors, badResponses, close: () => endStream(consoleLog) };
 }
 
 // window.rfbsimState as plain data (null before app.js set it).
@@ -386,6 +423,7 @@ function cleanup() {
     if (context) {
       await Promise.race([context.close().catch(() => {}), sleep(10_000)]);
     }
+    const logsWritten = consoleLogs.map(endStream);
     for (const sim of sims) {
       if (!sim.exited) {
         log(`cleanup: stopping ${sim.name} (pid ${sim.child.pid})`);
@@ -396,8 +434,11 @@ function cleanup() {
           await Promise.race([sim.exitedPromise, sleep(2000)]);
         }
       }
-      sim.logFile.end();
+      // The sim's last lines may still be in its pipes after 'exit': read them into the log before it ends.
+      await Promise.race([sim.closedPromise, sleep(STREAM_END_TIMEOUT_MS)]);
+      logsWritten.push(endStream(sim.logFile));
     }
+    await Promise.all(logsWritten);
     if (userDataDir) {
       fs.rmSync(userDataDir, { recursive: true, force: true });
     }
@@ -427,40 +468,53 @@ function printSimTails() {
   }
 }
 
+// The exit code of the first failure reported (null while none): it is the one printed and the one that stands.
+let failureExitCode = null;
+
+// Prints `FAIL: message` and the sims' last output for the first failure only. A later one (main failing because
+// the watchdog's cleanup closed the browser under it, say) is only logged, as `message` without its stack.
+function reportFailure(message, exitCode) {
+  if (failureExitCode === null) {
+    failureExitCode = exitCode;
+    console.error(`FAIL: ${message}`);
+    printSimTails();
+  } else {
+    log(`after the failure above: ${message.split('\n')[0]}`);
+  }
+}
+
 // Runs main() under an overall timeout (RFBSIM_E2E_TIMEOUT_S, else defaultTimeoutS), prints PASS or FAIL,
 // cleans up and exits the process: 0 passed, 1 a check failed or interrupted, 2 overall timeout.
 export async function runTest(testName, defaultTimeoutS, main) {
   const overallTimeoutMs = 1000 * Number(process.env.RFBSIM_E2E_TIMEOUT_S || defaultTimeoutS);
   const watchdog = setTimeout(() => {
-    console.error(`FAIL: overall timeout of ${overallTimeoutMs / 1000} s reached`);
-    printSimTails();
-    const hardExit = setTimeout(() => process.exit(2), 15_000);
+    reportFailure(`overall timeout of ${overallTimeoutMs / 1000} s reached`, 2);
+    const hardExit = setTimeout(() => process.exit(failureExitCode), 15_000);
     hardExit.unref();
-    cleanup().finally(() => process.exit(2));
+    cleanup().finally(() => process.exit(failureExitCode));
   }, overallTimeoutMs);
 
   for (const signal of ['SIGINT', 'SIGTERM']) {
     process.on(signal, () => {
-      console.error(`FAIL: interrupted by ${signal}`);
-      cleanup().finally(() => process.exit(1));
+      reportFailure(`interrupted by ${signal}`, 1);
+      cleanup().finally(() => process.exit(failureExitCode));
     });
   }
 
-  let exitCode = 0;
   try {
     await main();
-    log(`PASS: ${testName}`);
-  } catch (err) {
-    exitCode = 1;
-    if (err instanceof CheckFailed) {
-      console.error(`FAIL: ${err.message}`);
-    } else {
-      console.error(`FAIL: unexpected error: ${err && err.stack ? err.stack : err}`);
+    if (failureExitCode === null) {
+      log(`PASS: ${testName}`);
     }
-    printSimTails();
+  } catch (err) {
+    if (err instanceof CheckFailed) {
+      reportFailure(err.message, 1);
+    } else {
+      reportFailure(`unexpected error: ${err && err.stack ? err.stack : err}`, 1);
+    }
   } finally {
     await cleanup();
     clearTimeout(watchdog);
   }
-  process.exit(exitCode);
+  process.exit(failureExitCode ?? 0);
 }

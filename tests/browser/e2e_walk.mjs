@@ -171,7 +171,7 @@ async function main() {
   await panel.waitFor({ state: 'visible', timeout: 10_000 });
 
   check(pageErrors.length === 0, `uncaught errors in the page: ${pageErrors.join(' | ')}`);
-  closeConsoleLog();
+  await closeConsoleLog();
 }
 
 await runTest('browser_e2e_walk', 90, main);
