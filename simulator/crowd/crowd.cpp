@@ -84,12 +84,12 @@ Crowd::Crowd(const World& world, CrowdSpec spec, SocialForceParams params)
   const std::size_t count = static_cast<std::size_t>(std::max(0, spec_.count));
   walkers_.resize(count);
   spawned_.reserve(count);
-  const std::vector<Neighbour> standing = avatar_and_robot(world);
+  std::vector<Neighbour> standing;
+  append_avatar_and_robot(world, standing);
   for (std::size_t i = 0; i < count; ++i) place(i, standing, spawned_);
 }
 
-std::vector<Neighbour> Crowd::avatar_and_robot(const World& world) const {
-  std::vector<Neighbour> bodies;
+void Crowd::append_avatar_and_robot(const World& world, std::vector<Neighbour>& bodies) const {
   if (params_.react_to_avatar) {
     const Avatar& a = world.avatar;
     const Eigen::Vector2d heading(std::cos(a.pose.yaw), std::sin(a.pose.yaw));
@@ -99,7 +99,6 @@ std::vector<Neighbour> Crowd::avatar_and_robot(const World& world) const {
     const Robot& r = *world.robot;
     bodies.push_back({{r.pose.x, r.pose.y}, r.velocity, r.radius});
   }
-  return bodies;
 }
 
 std::vector<Person> Crowd::spawn() const { return spawned_; }
@@ -272,7 +271,7 @@ void Crowd::step(World& world, double dt) {
     const Person& p = world.people[i];
     now[i] = {{p.pose.x, p.pose.y}, p.velocity, p.radius};
   }
-  for (const Neighbour& body : avatar_and_robot(world)) now.push_back(body);
+  append_avatar_and_robot(world, now);
   const DistanceField& field = planner_.field();
   for (std::size_t i = 0; i < n; ++i) {
     Person& person = world.people[i];

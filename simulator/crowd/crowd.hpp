@@ -60,13 +60,14 @@ class Crowd {
 
   /// Places person `index` clear of walls, of `standing` (the avatar and the robot) and of `placed`.
   void place(std::size_t index, const std::vector<Neighbour>& standing, std::vector<Person>& placed);
-  /// The avatar and the robot as bodies people react to (as react_to_avatar / react_to_robot say).
-  [[nodiscard]] std::vector<Neighbour> avatar_and_robot(const World& world) const;
+  /// Appends the avatar and the robot to `bodies`, as bodies people react to (as react_to_avatar and
+  /// react_to_robot say).
+  void append_avatar_and_robot(const World& world, std::vector<Neighbour>& bodies) const;
   void choose_next_goal(Walker& walker);
   void plan_to_goal(Walker& walker, const Eigen::Vector2d& from);
   [[nodiscard]] Eigen::Vector2d random_free_point(std::mt19937_64& rng) const;
   /// The way person `self` wants to walk; `bodies` are everyone this tick (people first, in order, then
-  /// avatar_and_robot), to tell whether its goal is taken.
+  /// the avatar and the robot), to tell whether its goal is taken.
   [[nodiscard]] Eigen::Vector2d desired_direction(Walker& walker, const Person& person,
                                                   const std::vector<Neighbour>& bodies, std::size_t self, double dt);
 

@@ -42,15 +42,14 @@ DrawPlan plan_draws(const Scene& scene) {
   for (const std::uint32_t i : standing) {
     distance[i] = (items[i].model.translation() - scene.camera.eye).squaredNorm();
   }
-  const auto shape_rank = [](Shape shape) { return static_cast<int>(shape); };  // Box, Sphere, Cylinder, Disc
+  // Shapes in their enum's order: Box, Sphere, Cylinder, Disc.
   std::stable_sort(standing.begin(), standing.end(), [&](std::uint32_t a, std::uint32_t b) {
-    const auto ra = shape_rank(items[a].shape);
-    const auto rb = shape_rank(items[b].shape);
-    return ra != rb ? ra < rb : distance[a] < distance[b];
+    const Shape sa = items[a].shape;
+    const Shape sb = items[b].shape;
+    return sa != sb ? sa < sb : distance[a] < distance[b];
   });
-  std::stable_sort(floors.begin(), floors.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return shape_rank(items[a].shape) < shape_rank(items[b].shape);
-  });
+  std::stable_sort(floors.begin(), floors.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return items[a].shape < items[b].shape; });
 
   DrawPlan plan;
   plan.order.reserve(items.size());
