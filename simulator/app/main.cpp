@@ -87,7 +87,16 @@ std::unique_ptr<rfbsim::sim::Simulation> make_simulation(const rfbsim::sim::SimO
   sim::apply_overrides(scenario, overrides);
   std::fprintf(stderr, "[sim_rfb] scenario %s (%s), seed %llu, %d people\n", scenario.name.c_str(),
                file.string().c_str(), static_cast<unsigned long long>(scenario.seed), scenario.crowd.count);
-  return std::make_unique<sim::Simulation>(params, sim::make_world(scenario), scenario.crowd);
+  return std::make_unique<sim::Simulation>(params, sim::make_world(scenario), scenario.crowd,
+                                           sim::robot_setup(scenario));
+}
+
+// The robot's state changes of the last tick, one log line each ("[robot] 12.35 s moving: ...").
+void log_robot_events(const rfbsim::sim::World& world) {
+  for (const rfbsim::sim::RobotEvent& event : world.robot_events) {
+    std::fprintf(stderr, "[robot] %.2f s %s: %s\n", world.time, rfbsim::sim::robot_state_name(event.state),
+                 event.detail.c_str());
+  }
 }
 
 int run(const rfbsim::sim::SimOptions& options) {
@@ -128,6 +137,8 @@ int run(const rfbsim::sim::SimOptions& options) {
 
   sim::FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / options.tick_hz));
   const auto frame_interval = std::chrono::nanoseconds(1'000'000'000LL / options.fps);
+  sim::SceneStyle scene_style;
+  scene_style.debug_overlay = options.debug_overlay;
   std::uint64_t frames_rendered = 0;
   std::optional<sim::Scene> last_drawn;  // the server keeps showing it; an equal scene is not drawn again
 
@@ -147,7 +158,10 @@ int run(const rfbsim::sim::SimOptions& options) {
     for (const rfbsim::InputEvent& event : server.poll_input()) {
       if (event.kind == rfbsim::InputEvent::Kind::Key) simulation.apply_key(event.keysym, event.down);
     }
-    for (int i = 0; i < ticks; ++i) simulation.step();
+    for (int i = 0; i < ticks; ++i) {
+      simulation.step();
+      log_robot_events(simulation.world());
+    }
     const int clients = server.client_count();
     if (ticks > 0) status.publish(sim::status_json(simulation.world(), clients, frames_rendered));
 
@@ -155,7 +169,7 @@ int run(const rfbsim::sim::SimOptions& options) {
     if (clients == 0) {
       next_frame = now;
     } else if (now >= next_frame) {
-      sim::Scene scene = sim::build_scene(simulation.world());
+      sim::Scene scene = sim::build_scene(simulation.world(), scene_style);
       if (!last_drawn || !sim::same_scene(scene, *last_drawn)) {
         gl.begin_frame();
         renderer.draw(scene, gl.width(), gl.height());

@@ -27,6 +27,7 @@ std::string sim_usage() {
          "               [--scenario NAME|PATH] [--avatar-start P] [--avatar-goal P] [--robot-start P]\n"
          "               [--robot-goal P] [--crowd N]\n"
          "               [--quality Q] [--max-clients N] [--web-root DIR] [--egl auto|device|surfaceless]\n"
+         "               [--debug-overlay]\n"
          "  --port N         TCP port for the page, WebSocket and RFB (default 5901; 0 = any free port)\n"
          "  --bind ADDR      numeric address to listen on (default 127.0.0.1)\n"
          "  --width W        frame width in pixels, 160..3840 (default 1280)\n"
@@ -40,7 +41,9 @@ std::string sim_usage() {
          "  --quality Q      JPEG quality 1..100 (default 80)\n"
          "  --max-clients N  viewers at once, 1..64 (default 4)\n"
          "  --web-root DIR   directory holding the participant page (default: the built page)\n"
-         "  --egl P          EGL platform (default auto: GPU device, else Mesa surfaceless)\n";
+         "  --egl P          EGL platform (default auto: GPU device, else Mesa surfaceless)\n"
+         "  --debug-overlay  draw the robot's global path, local trajectory, goal, pose estimate and social\n"
+         "                   cost on the floor (for developers; participants should not see it)\n";
 }
 
 ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
@@ -82,6 +85,10 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
     const std::string& arg = args[i];
     if (arg == "--help" || arg == "-h") {
       o.help = true;
+      continue;
+    }
+    if (arg == "--debug-overlay") {
+      o.debug_overlay = true;
       continue;
     }
     auto option = with_value.find(arg);

@@ -26,6 +26,7 @@ struct SimOptions {
   int max_clients = 4;
   std::string web_root;             ///< empty = the built or installed page
   std::string egl_platform = "auto";
+  bool debug_overlay = false;       ///< draw the robot's path, trajectory, goal and social cost (for developers)
   bool help = false;
 };
 

@@ -17,11 +17,12 @@ World with_people(World world, const Crowd& crowd) {
 
 }  // namespace
 
-Simulation::Simulation(SimulationParams params, World initial, CrowdSpec crowd)
+Simulation::Simulation(SimulationParams params, World initial, CrowdSpec crowd, RobotSetup robot)
     : params_(params),
       crowd_(initial, std::move(crowd), params.crowd),
       physics_() {
   world_ = with_people(std::move(initial), crowd_);
+  if (world_.robot) robot_ = std::make_unique<RobotStack>(world_, std::move(robot));
   physics_ = std::make_unique<PhysicsWorld>(world_, params_.physics);
 }
 
@@ -33,6 +34,8 @@ void Simulation::step() {
   step_camera(params_.camera, controls_.state(), params_.dt, world_.camera);
   // Crowd: each person's wanted velocity from the social forces.
   crowd_.step(world_, params_.dt);
+  // Robot: sense, localize, plan, and set the wheels' wanted velocity.
+  if (robot_) robot_->step(world_, params_.dt);
   // Physics: everybody moves as far as walls, props and each other let them; contacts become events.
   auto& before = positions_before_physics_;
   before.clear();
@@ -46,6 +49,11 @@ void Simulation::step() {
   world_.time = static_cast<double>(world_.tick) * params_.dt;
 }
 
+std::optional<std::string> Simulation::send_robot_goal(const Pose2& goal) {
+  if (!robot_) return std::string("there is no robot");
+  return robot_->send_goal(world_, goal);
+}
+
 std::string status_json(const World& world, int clients, std::uint64_t frames_rendered) {
   char text[768];
   std::snprintf(text, sizeof text,
@@ -57,8 +65,12 @@ std::string status_json(const World& world, int clients, std::uint64_t frames_re
                 world.avatar.pose.yaw, world.avatar.speed, world.camera.height, world.people.size());
   std::string json = text;
   if (world.robot) {
-    std::snprintf(text, sizeof text, ",\"robot\":{\"x\":%.4f,\"y\":%.4f,\"yaw\":%.4f}", world.robot->pose.x,
-                  world.robot->pose.y, world.robot->pose.yaw);
+    const Robot& r = *world.robot;
+    std::snprintf(text, sizeof text,
+                  ",\"robot\":{\"x\":%.4f,\"y\":%.4f,\"yaw\":%.4f,\"speed\":%.4f,\"state\":\"%s\","
+                  "\"estimate\":{\"x\":%.4f,\"y\":%.4f,\"yaw\":%.4f}}",
+                  r.pose.x, r.pose.y, r.pose.yaw, r.velocity.norm(), robot_state_name(r.state), r.estimate.x,
+                  r.estimate.y, r.estimate.yaw);
     json += text;
   }
   return json + "}";

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "avatar/avatar_motion.hpp"
 #include "crowd/crowd.hpp"
 #include "physics/physics_world.hpp"
+#include "robot/robot_stack.hpp"
 #include "world/world.hpp"
 
 namespace rfbsim::sim {
@@ -27,8 +29,10 @@ struct SimulationParams {
 
 class Simulation {
  public:
-  /// Spawns the crowd described by `crowd` into `initial` and builds the physics of the result.
-  Simulation(SimulationParams params, World initial, CrowdSpec crowd = {});
+  /// Spawns the crowd described by `crowd` into `initial`, builds the robot's stack from `robot` when the
+  /// world has a robot (no mission when not given), and builds the physics of the result. Throws
+  /// std::invalid_argument for robot parameters that cannot work.
+  Simulation(SimulationParams params, World initial, CrowdSpec crowd = {}, RobotSetup robot = {});
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -37,18 +41,23 @@ class Simulation {
   void apply_key(std::uint32_t keysym, bool down) { controls_.apply_key(keysym, down); }
   /// Releases every control (the participant left).
   void release_controls() { controls_.release_all(); }
-  /// Advances one fixed tick: input, avatar, crowd, physics, clock.
+  /// Advances one fixed tick: input, avatar, crowd, robot (sense, localize, plan, act), physics, clock.
   void step();
 
   [[nodiscard]] const World& world() const { return world_; }
   [[nodiscard]] const SimulationParams& params() const { return params_; }
   [[nodiscard]] const ControlState& controls() const { return controls_.state(); }
+  /// The robot's navigation stack; null when the world has no robot.
+  [[nodiscard]] const RobotStack* robot_stack() const { return robot_.get(); }
+  /// Sends the robot to `goal` (see RobotStack::send_goal); the reason when refused or there is no robot.
+  std::optional<std::string> send_robot_goal(const Pose2& goal);
 
  private:
   SimulationParams params_;
   World world_;
   AvatarControls controls_;
   Crowd crowd_;
+  std::unique_ptr<RobotStack> robot_;
   std::unique_ptr<PhysicsWorld> physics_;
   std::vector<Eigen::Vector2d> positions_before_physics_;  // reused each tick: how far each person moved
 };

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// build_scene: floor, walls, props, landmarks, robot, people, avatar, camera.
+// build_scene: floor, walls, props, landmarks, robot, people, avatar, the debug overlay, camera.
 #include "render/scene_builder.hpp"
 
 #include <algorithm>
@@ -69,6 +69,9 @@ Scene build_scene(const World& world, const SceneStyle& style) {
   append_humanoid(scene.items, feet, yaw, static_cast<float>(avatar.gait_phase), swing, style.avatar_height,
                   rgb(0x2f7fd0));
   append_soft_shadow(scene.items, feet.x(), feet.y(), 0.4f);
+
+  // The navigation overlay last: its translucent squares then blend over the shadows and the floor.
+  if (style.debug_overlay && world.robot) append_nav_overlay(scene.items, *world.robot, style.overlay);
 
   // Third-person camera: behind the avatar at the rig's height, looking at its chest a little ahead.
   // It comes closer rather than pass through a wall or a tall shelf behind the avatar.

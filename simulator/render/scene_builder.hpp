@@ -3,18 +3,23 @@
 #pragma once
 
 #include "render/draw_list.hpp"
+#include "render/nav_overlay.hpp"
 #include "world/world.hpp"
 
 namespace rfbsim::sim {
 
-/// Geometry constants of the drawn world.
+/// How the world is drawn: geometry constants and the optional debug layers.
 struct SceneStyle {
   float wall_height = 2.2f;       ///< m
   float avatar_height = 1.75f;    ///< m, top of the head
+  bool debug_overlay = false;     ///< draw the robot's plan, trajectory, goal, estimate and social cost
+  NavOverlayStyle overlay;        ///< how that overlay looks
 };
 
 /// Builds the frame's scene: floor, walls (merged runs), props by kind, landmarks, the robot, the people and
 /// the avatar with their gaits and shadows, and a third-person camera behind the avatar at the rig's height.
+/// With `style.debug_overlay` and a robot, the navigation overlay (nav_overlay.hpp) follows as the last items;
+/// without, the scene is exactly what it is without the overlay code.
 Scene build_scene(const World& world, const SceneStyle& style = {});
 
 /// How one humanoid looks: colours (RGB 0..1) and how broad it is.

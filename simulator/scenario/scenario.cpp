@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "map/map_server_loader.hpp"
+#include "scenario/robot_params_yaml.hpp"
 #include "scenario/yaml_field.hpp"
 
 namespace rfbsim::sim {
@@ -172,7 +173,8 @@ void parse_crowd(Scenario& scenario, const GridMap& obstacles, const YamlField& 
 }
 
 void parse_robot(Scenario& scenario, const YamlField& robot) {
-  robot.allow_only({"start", "mission"});
+  robot.allow_only({"start", "mission", "nav"});
+  if (auto nav = robot.optional("nav")) parse_robot_params(*nav, scenario.robot.params);
   scenario.robot.present = true;
   scenario.robot.start = parse_place(scenario, robot.required("start"));
   auto mission_field = robot.optional("mission");
@@ -389,6 +391,15 @@ void apply_overrides(Scenario& scenario, const ScenarioOverrides& overrides) {
   }
 }
 
+RobotSetup robot_setup(const Scenario& scenario) {
+  RobotSetup setup;
+  setup.params = scenario.robot.params;
+  setup.mission = scenario.robot.mission;
+  // The robot's streams (lidar noise, odometry drift, particles, wander picks) apart from the crowd's.
+  setup.seed = scenario.seed * 0x9e3779b97f4a7c15ULL + 0x726f626f74ULL;
+  return setup;
+}
+
 World make_world(const Scenario& scenario) {
   World world;
   world.map = scenario.map;
@@ -404,6 +415,7 @@ World make_world(const Scenario& scenario) {
   if (scenario.robot.present) {
     Robot robot;
     robot.pose = scenario.robot.start;
+    robot.estimate = robot.pose;
     world.robot = robot;
   }
   return world;

@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "crowd/crowd_spec.hpp"
+#include "robot/mission.hpp"
+#include "robot/robot_stack.hpp"
 #include "world/world.hpp"
 
 namespace rfbsim::sim {
@@ -29,18 +31,11 @@ struct SpawnPoint {
   Pose2 pose;
 };
 
-/// What the robot does (carried out by the robot's navigator).
-struct MissionSpec {
-  enum class Kind { None, GoTo, Patrol, Wander };
-  Kind kind = Kind::None;
-  std::vector<Pose2> waypoints;  ///< GoTo: one goal; Patrol: the loop; Wander: the places to pick from
-  std::vector<std::string> waypoint_names;  ///< the spawn names they came from ("" for literal poses)
-};
-
 struct RobotSpec {
   bool present = false;
   Pose2 start;
   MissionSpec mission;
+  RobotParams params;  ///< defaults, overridden by the file's `robot.nav`
 };
 
 struct Scenario {
@@ -81,6 +76,9 @@ struct ScenarioOverrides {
 /// Applies overrides and re-checks the poses against the map. Throws ScenarioError naming the option
 /// ("--avatar-start: no spawn point 'dok' in warehouse (known: dock, aisle_a, ...)").
 void apply_overrides(Scenario& scenario, const ScenarioOverrides& overrides);
+
+/// The robot's setup for a Simulation: its parameters, its mission, and a seed derived from the scenario's.
+RobotSetup robot_setup(const Scenario& scenario);
 
 /// The initial world: map, obstacles (map + props), props, landmarks (with the avatar's goal), avatar
 /// and robot at their starts. People are added by the crowd system.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "map/grid_map.hpp"
+#include "robot/costmap/costmap_grid.hpp"
 
 namespace rfbsim::sim {
 
@@ -60,13 +61,48 @@ struct Person {
   double gait_phase = 0.0;     ///< radians of the walking cycle
 };
 
-/// The robot's physical state (its navigation stack comes with the robot issue).
+/// What the robot's navigator is doing (reported as events when it changes).
+enum class RobotState { Idle, Planning, Moving, Recovering, Arrived, Failed };
+
+/// Lower-case name of a state, as written in events and status.json ("moving").
+inline const char* robot_state_name(RobotState state) {
+  switch (state) {
+    case RobotState::Idle: return "idle";
+    case RobotState::Planning: return "planning";
+    case RobotState::Moving: return "moving";
+    case RobotState::Recovering: return "recovering";
+    case RobotState::Arrived: return "arrived";
+    case RobotState::Failed: return "failed";
+  }
+  return "unknown";
+}
+
+/// What the navigation stack last decided, for the debug overlay (`--debug-overlay`) and for status.
+struct RobotNavView {
+  std::vector<Eigen::Vector2d> global_path;       ///< world points, robot to goal; empty without a plan
+  std::vector<Eigen::Vector2d> local_trajectory;  ///< the chosen DWA rollout, world points
+  CostmapGrid social;     ///< the local costmap's proxemic costs (0 = none), a window around the robot
+  std::optional<Pose2> goal;  ///< the current goal
+};
+
+/// The robot's navigator changed state (or began another recovery behaviour, or gave up).
+struct RobotEvent {
+  std::uint64_t tick = 0;
+  RobotState state = RobotState::Idle;
+  std::string detail;  ///< why, in words: "goal (10.00, 2.80)", "gave up: no global plan for 5.0 s: ..."
+};
+
+/// The robot: its physical state (written by physics and its drive) and what its stack believes and plans.
 struct Robot {
   Pose2 pose;
-  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< m/s, world frame
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< m/s, world frame: wanted before physics, actual after
   double yaw_rate = 0.0;   ///< rad/s
   double radius = 0.16;    ///< m, Kuri's footprint
   double height = 0.5;     ///< m
+  double head_yaw = 0.0;   ///< rad, the head turned against the body, toward where the robot is heading
+  RobotState state = RobotState::Idle;
+  Pose2 estimate;          ///< where localization believes the robot is (the pose the planners use)
+  RobotNavView nav;
 };
 
 /// Who took part in a contact.
@@ -111,6 +147,7 @@ struct World {
   std::uint64_t tick = 0;  ///< fixed steps taken
   double time = 0.0;       ///< simulated seconds = tick * dt
   std::vector<ContactEvent> contacts;  ///< contacts that began during the last tick
+  std::vector<RobotEvent> robot_events;  ///< the robot's state changes during the last tick
 };
 
 /// `map` with every prop's box blocked too: what World::obstacles holds.

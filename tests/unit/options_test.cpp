@@ -53,3 +53,14 @@ TEST_CASE("bad arguments are named") {
   CHECK(parse_sim_options({"--frobnicate"}).error == "unknown argument '--frobnicate'");
   CHECK(parse_sim_options({"--help"}).options.help);
 }
+
+TEST_CASE("the debug overlay flag is off by default, takes no value, and is in the usage text") {
+  CHECK_FALSE(parse_sim_options({}).options.debug_overlay);
+  const auto o = parse_sim_options({"--debug-overlay", "--port", "0"});
+  REQUIRE(o.error.empty());
+  CHECK(o.options.debug_overlay);
+  CHECK(o.options.port == 0);  // the flag takes no value: the next option is still read
+  CHECK(parse_sim_options({"--port", "0", "--debug-overlay"}).options.debug_overlay);
+  CHECK(parse_sim_options({"--debug-overlay=1"}).error == "unknown argument '--debug-overlay=1'");
+  CHECK(rfbsim::sim::sim_usage().find("--debug-overlay") != std::string::npos);
+}

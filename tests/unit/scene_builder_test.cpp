@@ -216,7 +216,7 @@ TEST_CASE("scene: the world's things are all in the scene at their places", "[sc
   for (const DrawItem& item : robot) {
     if (item.opacity < 1.0f) continue;
     top = std::max(top, static_cast<double>(corners(item)[7].z()));
-    if (item.shape == Shape::Sphere && item.color.maxCoeff() < 0.3f) {
+    if (item.shape == Shape::Sphere && item.color.maxCoeff() < 0.1f) {
       ++eyes;
       CHECK(item.model.translation().x() > 3.1f);
     }
@@ -243,4 +243,92 @@ TEST_CASE("scene: building is deterministic and a warehouse stays within the ite
   const auto scene = rfbsim::sim::build_scene(world);
   INFO("items: " << scene.items.size());
   CHECK(scene.items.size() < 2500);
+}
+
+TEST_CASE("scene: the robot's head, face and eyes turn with head_yaw; its body and shadow do not", "[scene]") {
+  using rfbsim::sim::kRobotBodyItems;
+  using rfbsim::sim::kRobotHeadItems;
+  rfbsim::sim::Robot robot;
+  robot.pose = {3.0, 5.0, 0.4};
+  std::vector<DrawItem> ahead, turned;
+  rfbsim::sim::append_robot(ahead, robot);
+  robot.head_yaw = 0.9;
+  rfbsim::sim::append_robot(turned, robot);
+  REQUIRE(ahead.size() == kRobotBodyItems + kRobotHeadItems + 2);
+  REQUIRE(ahead.size() < 15);  // small enough to cost nothing per frame
+  REQUIRE(turned.size() == ahead.size());
+  for (std::size_t i = 0; i < ahead.size(); ++i) {
+    INFO("item " << i);
+    const bool head = i >= kRobotBodyItems && i < kRobotBodyItems + kRobotHeadItems;
+    CHECK(ahead[i].model.matrix().isApprox(turned[i].model.matrix()) == !head);
+  }
+  // The eyes (black) sit either side of the head's forward axis: their midpoint points along the body's
+  // yaw plus the head's, 0.1175 m out (1.02 x the head's 0.1152 m radius), at 0.43 m.
+  const std::size_t eye = kRobotBodyItems + 2;
+  const auto eyes_direction = [&](const std::vector<DrawItem>& items) {
+    CHECK(items[eye].color.maxCoeff() < 0.1f);
+    CHECK(items[eye + 2].color.maxCoeff() < 0.1f);
+    const Eigen::Vector3f mid = 0.5f * (items[eye].model.translation() + items[eye + 2].model.translation());
+    CHECK(std::hypot(mid.x() - 3.0f, mid.y() - 5.0f) == Approx(1.02 * 0.72 * 0.16).epsilon(1e-4));
+    CHECK(mid.z() == Approx(0.5 - 0.08 + 0.01).epsilon(1e-4));
+    return std::atan2(static_cast<double>(mid.y()) - 5.0, static_cast<double>(mid.x()) - 3.0);
+  };
+  CHECK(eyes_direction(ahead) == Approx(0.4).margin(1e-5));
+  CHECK(eyes_direction(turned) == Approx(1.3).margin(1e-5));
+  // The sensor window and the heart light stay on the body's front whichever way the head looks.
+  for (const std::size_t i : {kRobotBodyItems - 2, kRobotBodyItems - 1}) {
+    const Eigen::Vector3f front = turned[i].model.translation();
+    CHECK(std::atan2(static_cast<double>(front.y()) - 5.0, static_cast<double>(front.x()) - 3.0) ==
+          Approx(0.4).margin(1e-5));
+  }
+  // The top of the dome is the robot's height, turned or not, and the body fills its footprint without
+  // reaching past it: every part is a sphere or cylinder turned about z, so its reach along a horizontal
+  // direction u is its centre's plus half the length of its unit shape's axes projected on u.
+  double top = 0.0;
+  double widest = 0.0;
+  for (const DrawItem& item : turned) {
+    if (item.opacity < 1.0f) continue;  // the shadow is wider on purpose
+    REQUIRE(item.shape != Shape::Box);
+    top = std::max(top, static_cast<double>(corners(item)[7].z()));
+    for (int k = 0; k < 72; ++k) {
+      const float angle = 0.087266f * static_cast<float>(k);  // every 5 degrees
+      const Eigen::Vector3f u(std::cos(angle), std::sin(angle), 0.0f);
+      const float reach = (item.model.translation() - Eigen::Vector3f(3.0f, 5.0f, 0.0f)).dot(u) +
+                          0.5f * (item.model.linear().transpose() * u).norm();
+      widest = std::max(widest, static_cast<double>(reach));
+    }
+  }
+  CHECK(top == Approx(0.5).margin(1e-4));
+  CHECK(widest == Approx(0.16).margin(1e-4));
+}
+
+TEST_CASE("scene: the robot's heart light tells the navigator's state; a broken pose draws nothing", "[scene]") {
+  const std::size_t light = rfbsim::sim::kRobotBodyItems - 1;
+  rfbsim::sim::Robot robot;
+  std::vector<DrawItem> moving, failed;
+  robot.state = rfbsim::sim::RobotState::Moving;
+  rfbsim::sim::append_robot(moving, robot);
+  robot.state = rfbsim::sim::RobotState::Failed;
+  rfbsim::sim::append_robot(failed, robot);
+  REQUIRE(moving.size() == failed.size());
+  for (std::size_t i = 0; i < moving.size(); ++i) {
+    INFO("item " << i);
+    CHECK((moving[i].color == failed[i].color) == (i != light));
+  }
+  CHECK(failed[light].color.x() > 0.9f);  // red
+  CHECK(failed[light].color.y() < 0.3f);
+
+  std::vector<DrawItem> none;
+  robot.pose.x = std::nan("");
+  rfbsim::sim::append_robot(none, robot);
+  CHECK(none.empty());
+  robot.pose.x = 1.0;
+  robot.radius = 0.0;
+  rfbsim::sim::append_robot(none, robot);
+  CHECK(none.empty());
+  robot.radius = 0.16;
+  robot.head_yaw = std::nan("");  // a broken head angle: the head looks ahead
+  rfbsim::sim::append_robot(none, robot);
+  REQUIRE(none.size() == moving.size());
+  for (const DrawItem& item : none) CHECK(item.model.matrix().allFinite());
 }

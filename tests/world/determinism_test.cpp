@@ -25,8 +25,8 @@ bool bitwise_equal(const std::vector<double>& a, const std::vector<double>& b) {
 }  // namespace
 
 TEST_CASE("the warehouse run twice with one seed and one key script matches bit for bit at every tick") {
-  auto first = rfbsim::test::make_scenario_simulation("warehouse", 11);
-  auto second = rfbsim::test::make_scenario_simulation("warehouse", 11);
+  auto first = rfbsim::test::make_scenario_simulation("warehouse", 11, {}, true);
+  auto second = rfbsim::test::make_scenario_simulation("warehouse", 11, {}, true);
   const auto a = rfbsim::test::run_scripted(*first, kScript, kTicks);
   const auto b = rfbsim::test::run_scripted(*second, kScript, kTicks);
   REQUIRE(a.size() == kTicks);
@@ -50,8 +50,8 @@ TEST_CASE("the warehouse run twice with one seed and one key script matches bit 
 }
 
 TEST_CASE("another seed gives another crowd") {
-  auto one = rfbsim::test::make_scenario_simulation("warehouse", 11);
-  auto other = rfbsim::test::make_scenario_simulation("warehouse", 12);
+  auto one = rfbsim::test::make_scenario_simulation("warehouse", 11, {}, true);
+  auto other = rfbsim::test::make_scenario_simulation("warehouse", 12, {}, true);
   const auto a = rfbsim::test::run_scripted(*one, {}, 60);
   const auto b = rfbsim::test::run_scripted(*other, {}, 60);
   // The avatar starts where the scenario says whatever the seed; the people do not.

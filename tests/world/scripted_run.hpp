@@ -18,13 +18,18 @@ struct ScriptedKey {
   bool down;
 };
 
-/// The warehouse (or another shipped scenario) as sim_rfb would build it, with the given seed.
+/// The warehouse (or another shipped scenario) as sim_rfb would build it, with the given seed. Without
+/// `robot_mission` the robot's stack runs but it is given no goal: it stands (tests of the crowd and pushes).
 inline std::unique_ptr<sim::Simulation> make_scenario_simulation(const std::string& name, std::uint64_t seed,
-                                                                 sim::ScenarioOverrides overrides = {}) {
+                                                                 sim::ScenarioOverrides overrides = {},
+                                                                 bool robot_mission = false) {
   sim::Scenario scenario = sim::load_scenario(std::string(RFBSIM_SCENARIO_DIR) + "/" + name + ".yaml");
   overrides.seed = seed;
   sim::apply_overrides(scenario, overrides);
-  return std::make_unique<sim::Simulation>(sim::SimulationParams{}, sim::make_world(scenario), scenario.crowd);
+  sim::RobotSetup robot = sim::robot_setup(scenario);
+  if (!robot_mission) robot.mission = {};
+  return std::make_unique<sim::Simulation>(sim::SimulationParams{}, sim::make_world(scenario), scenario.crowd,
+                                           robot);
 }
 
 /// Every agent's x, y, yaw in a fixed order: avatar, people by index, robot.

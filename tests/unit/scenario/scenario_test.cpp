@@ -2,7 +2,13 @@
 // The shipped scenarios load as documented, and overrides change exactly what they name.
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
 
 #include "scenario/scenario.hpp"
 
@@ -128,4 +134,44 @@ TEST_CASE("overrides move starts and goals by spawn name or x,y,yaw and reseed t
   ScenarioOverrides crowd;
   crowd.crowd_count = 501;
   rejected(crowd, "--crowd");
+}
+
+TEST_CASE("robot.nav overrides the robot's parameters by ROS name") {
+  const auto dir = std::filesystem::temp_directory_path() / ("rfbsim_nav_params_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_directories(dir / "maps");
+  for (const char* f : {"lab.yaml", "lab.pgm"}) {
+    std::filesystem::copy_file(std::string(RFBSIM_SCENARIO_DIR) + "/maps/" + f, dir / "maps" / f);
+  }
+  // The shipped lab with a nav block added to its robot section.
+  std::ifstream in(std::string(RFBSIM_SCENARIO_DIR) + "/lab.yaml");
+  std::ostringstream whole;
+  whole << in.rdbuf();
+  std::string text = whole.str();
+  const std::string anchor = "robot:\n";
+  const auto at = text.find(anchor);
+  REQUIRE(at != std::string::npos);
+  text.insert(at + anchor.size(),
+              "  nav:\n"
+              "    localization: ground_truth\n"
+              "    dwa: {max_vel_x: 0.45, vth_samples: 30}\n"
+              "    move_base: {xy_goal_tolerance: 0.2, recovery_behavior_enabled: false}\n"
+              "    proxemic: {amplitude: 100, covariance: 0.1}\n"
+              "    global_costmap: {inflation_radius: 0.5}\n");
+  std::ofstream(dir / "lab.yaml", std::ios::trunc) << text;
+  const Scenario s = load_scenario(dir / "lab.yaml");
+  std::filesystem::remove_all(dir);
+  const RobotParams& p = s.robot.params;
+  CHECK(p.localization == Localization::GroundTruth);
+  CHECK(p.dwa.max_vel_x == 0.45);
+  CHECK(p.dwa.vth_samples == 30);
+  CHECK(p.navigator.xy_goal_tolerance == 0.2);
+  CHECK_FALSE(p.navigator.recovery_behavior_enabled);
+  CHECK(p.global_costmap.proxemic.amplitude == 100.0);
+  CHECK(p.local_costmap.proxemic.covariance == 0.1);  // one proxemic model for both costmaps
+  CHECK(p.global_costmap.inflation.inflation_radius == 0.5);
+  CHECK(p.local_costmap.inflation.inflation_radius == 0.45);  // untouched default
+  // Everything else keeps REFERENCE.md's defaults.
+  CHECK(p.amcl.laser_max_beams == 30);
+  CHECK(p.dwa.sim_time == 1.7);
 }

@@ -1,0 +1,260 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// RobotStack: the robot's stages in order, on their own schedules.
+#include "robot/robot_stack.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace rfbsim::sim {
+
+namespace {
+
+/// Adds the wall-clock time of one run of a stage to `times` when it goes out of scope.
+class StageTimer {
+ public:
+  StageTimer(StageTimes& times, NavStage stage) : times_(times), stage_(static_cast<std::size_t>(stage)) {}
+  ~StageTimer() {
+    times_.seconds[stage_] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    ++times_.runs[stage_];
+  }
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+
+ private:
+  StageTimes& times_;
+  std::size_t stage_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+const Robot& robot_of(const World& world) {
+  if (!world.robot) throw std::invalid_argument("RobotStack: the world has no robot");
+  return *world.robot;
+}
+
+double positive_rate(double hz, const char* name) {
+  if (!(hz > 0.0) || !std::isfinite(hz)) {
+    throw std::invalid_argument(std::string("robot: ") + name + " must be a positive number of Hz");
+  }
+  return 1.0 / hz;
+}
+
+/// Moves a world point seen from the true pose into the frame the robot believes it is in.
+Eigen::Vector2d believed(const Eigen::Vector2d& point, const Pose2& truth, const Pose2& estimate) {
+  const Eigen::Rotation2Dd turn(estimate.yaw - truth.yaw);
+  return turn * (point - Eigen::Vector2d(truth.x, truth.y)) + Eigen::Vector2d(estimate.x, estimate.y);
+}
+
+/// The point `distance` m along `path` from its point nearest `from` (the path's end if it is shorter).
+Eigen::Vector2d look_ahead(const std::vector<Eigen::Vector2d>& path, const Eigen::Vector2d& from, double distance) {
+  std::size_t nearest = 0;
+  double best = 1e18;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const double d = (path[i] - from).squaredNorm();
+    if (d < best) {
+      best = d;
+      nearest = i;
+    }
+  }
+  for (std::size_t i = nearest; i + 1 < path.size(); ++i) {
+    if ((path[i + 1] - from).norm() >= distance) return path[i + 1];
+  }
+  return path.back();
+}
+
+/// The setup with the parameters that must agree made to agree: DWA's window is one control period wide,
+/// and the costmaps' footprint is the robot's body plus the padding.
+RobotSetup synced(RobotSetup setup, double robot_radius) {
+  RobotParams& p = setup.params;
+  p.dwa.controller_frequency = p.navigator.controller_frequency;
+  p.dwa.robot_radius = robot_radius;
+  p.global_costmap.robot_radius = robot_radius + p.footprint_padding;
+  p.local_costmap.robot_radius = robot_radius + p.footprint_padding;
+  return setup;
+}
+
+}  // namespace
+
+void people_in_view(const World& world, const Pose2& pose, double range, std::vector<SeenPerson>& out) {
+  out.clear();
+  const auto consider = [&](const Eigen::Vector2d& at, const Eigen::Vector2d& velocity, double radius) {
+    const Eigen::Vector2d offset = at - Eigen::Vector2d(pose.x, pose.y);
+    const double distance = offset.norm();
+    if (distance > range || !std::isfinite(distance)) return;
+    // In view when the ray toward the centre reaches the body before any wall or prop.
+    const double angle = std::atan2(offset.y(), offset.x());
+    const double clear = world.obstacles.ray_cast(pose.x, pose.y, angle, distance);
+    if (clear + 1e-9 < distance - radius) return;
+    out.push_back({at, velocity, radius});
+  };
+  for (const Person& p : world.people) consider({p.pose.x, p.pose.y}, p.velocity, p.radius);
+  const Avatar& a = world.avatar;
+  consider({a.pose.x, a.pose.y}, a.speed * Eigen::Vector2d(std::cos(a.pose.yaw), std::sin(a.pose.yaw)), a.radius);
+}
+
+RobotStack::RobotStack(const World& world, RobotSetup setup)
+    : setup_(synced(std::move(setup), robot_of(world).radius)),
+      drive_(setup_.params.drive),
+      odometry_(setup_.params.odometry, robot_of(world).pose, setup_.seed ^ 0x6f646f6dULL),
+      global_(world.obstacles, setup_.params.global_costmap),
+      local_(world.obstacles, setup_.params.local_costmap),
+      navigator_(setup_.params.navigator, setup_.params.planner, setup_.params.dwa),
+      mission_(setup_.mission, setup_.seed ^ 0x6d697373ULL),
+      lidar_rng_(setup_.seed ^ 0x6c696461ULL) {
+  check_lidar_params(setup_.params.lidar);
+  positive_rate(setup_.params.navigator.controller_frequency, "controller_frequency");
+  positive_rate(setup_.params.global_update_frequency, "global_update_frequency");
+  if (setup_.params.localization == Localization::Amcl) {
+    amcl_.emplace(world.obstacles, setup_.params.amcl, robot_of(world).pose, setup_.seed ^ 0x616d636cULL);
+  }
+}
+
+RobotStack::~RobotStack() = default;
+
+void RobotStack::step(World& world, double dt) {
+  world.robot_events.clear();
+  Robot& robot = *world.robot;
+  const double now = world.time;
+  if (cycles_ == 0 && now >= next_cycle_time_) next_mission_goal(world);
+
+  // Sense: the wheels count every tick; the lidar sweeps at its own rate, from the true pose.
+  odometry_.update(robot.pose);
+  if (now + 1e-9 >= next_scan_time_) {
+    StageTimer timer(times_, NavStage::Lidar);
+    collect_lidar_bodies(world, bodies_);
+    cast_scan_into(scan_, world.obstacles, bodies_, robot.pose, now, setup_.params.lidar, lidar_rng_);
+    scan_fresh_ = true;
+    next_scan_time_ = std::max(next_scan_time_ + 1.0 / setup_.params.lidar.rate_hz, now);
+  }
+  // Localize, map, plan at the controller's rate; the mission moves on after a pause at a waypoint.
+  if (now + 1e-9 >= next_cycle_time_) {
+    control_cycle(world);
+    next_cycle_time_ = std::max(next_cycle_time_ + 1.0 / setup_.params.navigator.controller_frequency, now);
+  }
+  if (resume_mission_at_ >= 0.0 && now + 1e-9 >= resume_mission_at_) {
+    resume_mission_at_ = -1.0;
+    next_mission_goal(world);
+  }
+  // Act: the wheels ramp toward the command every tick; the head follows the way ahead.
+  drive_.step(dt, robot);
+  turn_head(robot, dt);
+  record_events(world);
+}
+
+void RobotStack::control_cycle(World& world) {
+  Robot& robot = *world.robot;
+  const double now = world.time;
+  ++cycles_;
+
+  Pose2 estimate = robot.pose;
+  if (amcl_) {
+    StageTimer timer(times_, NavStage::Localization);
+    amcl_->update(odometry_.pose(), scan_fresh_ ? &scan_ : nullptr);
+    estimate = amcl_->estimate();
+  }
+  robot.estimate = estimate;
+
+  {
+    // The people detector sees from the true pose; what it reports lands where the robot believes it is.
+    StageTimer timer(times_, NavStage::Costmaps);
+    people_in_view(world, robot.pose, setup_.params.lidar.range_max, seen_);
+    if (amcl_) {
+      const Eigen::Rotation2Dd turn(estimate.yaw - robot.pose.yaw);
+      for (SeenPerson& person : seen_) {
+        person.position = believed(person.position, robot.pose, estimate);
+        person.velocity = turn * person.velocity;
+      }
+    }
+    const LaserScan* scan = scan_fresh_ ? &scan_ : nullptr;
+    local_.update(estimate, scan, seen_);
+    if (now + 1e-9 >= next_global_update_) {
+      global_.update(estimate, &scan_, seen_);
+      next_global_update_ = std::max(next_global_update_ + 1.0 / setup_.params.global_update_frequency, now);
+    }
+    scan_fresh_ = false;
+  }
+
+  // Someone stands on the goal when their body and the robot's could not both be there.
+  bool goal_occupied = false;
+  if (const auto& goal = navigator_.goal()) {
+    for (const SeenPerson& person : seen_) {
+      const double reach = person.radius + robot.radius;
+      goal_occupied = goal_occupied || (person.position - Eigen::Vector2d(goal->x, goal->y)).norm() < reach;
+    }
+  }
+  navigator_.set_people(seen_);
+  const NavigatorTimes before = navigator_.times();
+  const NavCommand command =
+      navigator_.cycle(now, estimate, drive_.v(), drive_.w(), global_.grid(), local_.grid(), goal_occupied);
+  const NavigatorTimes& after = navigator_.times();
+  const auto plan_index = static_cast<std::size_t>(NavStage::GlobalPlan);
+  const auto local_index = static_cast<std::size_t>(NavStage::LocalPlan);
+  times_.seconds[plan_index] += after.plan_seconds - before.plan_seconds;
+  times_.runs[plan_index] += after.plans - before.plans;
+  times_.seconds[local_index] += after.control_seconds - before.control_seconds;
+  times_.runs[local_index] += after.controls - before.controls;
+  if (command.clear_obstacles_beyond) {
+    const Eigen::Vector2d at(estimate.x, estimate.y);
+    global_.clear_obstacles_beyond(at, *command.clear_obstacles_beyond);
+    local_.clear_obstacles_beyond(at, *command.clear_obstacles_beyond);
+  }
+  drive_.command(command.v, command.w);
+
+  // A patrol or a wander goes on to its next waypoint after a pause, whether this one was reached or not.
+  const RobotState state = navigator_.state();
+  const bool done = state == RobotState::Arrived || state == RobotState::Failed;
+  const auto kind = mission_.spec().kind;
+  if (done && !goal_finished_) {
+    goal_finished_ = true;
+    if (kind == MissionSpec::Kind::Patrol || kind == MissionSpec::Kind::Wander) {
+      resume_mission_at_ = now + setup_.params.navigator.waypoint_pause;
+    }
+  }
+
+  // What the robot believes and plans, for status and the debug overlay.
+  robot.state = state;
+  robot.nav.global_path = navigator_.global_path();
+  robot.nav.local_trajectory = navigator_.local_trajectory();
+  robot.nav.social = local_.social();
+  robot.nav.goal = navigator_.goal();
+  head_target_ = 0.0;
+  if (!robot.nav.global_path.empty()) {
+    const Eigen::Vector2d ahead =
+        look_ahead(robot.nav.global_path, {estimate.x, estimate.y}, setup_.params.head_lookahead);
+    const double bearing = std::atan2(ahead.y() - estimate.y, ahead.x() - estimate.x);
+    const double limit = setup_.params.head_max_angle;
+    head_target_ = std::clamp(std::remainder(bearing - estimate.yaw, 2.0 * std::numbers::pi), -limit, limit);
+  }
+}
+
+void RobotStack::next_mission_goal(World& world) {
+  if (const auto goal = mission_.next_goal()) {
+    goal_finished_ = false;
+    navigator_.set_goal(*goal, world.obstacles, world.robot->radius);
+    world.robot->state = navigator_.state();
+  }
+}
+
+std::optional<std::string> RobotStack::send_goal(World& world, const Pose2& goal) {
+  resume_mission_at_ = -1.0;
+  goal_finished_ = false;
+  auto refusal = navigator_.set_goal(goal, world.obstacles, world.robot->radius);
+  world.robot->state = navigator_.state();
+  return refusal;
+}
+
+void RobotStack::record_events(World& world) {
+  for (NavEvent& event : navigator_.take_events()) {
+    world.robot_events.push_back({world.tick, event.state, std::move(event.detail)});
+  }
+}
+
+void RobotStack::turn_head(Robot& robot, double dt) const {
+  const double step = setup_.params.head_max_rate * dt;
+  robot.head_yaw += std::clamp(head_target_ - robot.head_yaw, -step, step);
+}
+
+}  // namespace rfbsim::sim
