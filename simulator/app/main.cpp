@@ -92,10 +92,10 @@ std::unique_ptr<rfbsim::sim::Simulation> make_simulation(const rfbsim::sim::SimO
 }
 
 // The robot's state changes of the last tick, one log line each ("[robot] 12.35 s moving: ...").
-void log_robot_events(const rfbsim::sim::World& world) {
+void log_robot_events(const rfbsim::sim::World& world, double dt) {
   for (const rfbsim::sim::RobotEvent& event : world.robot_events) {
-    std::fprintf(stderr, "[robot] %.2f s %s: %s\n", world.time, rfbsim::sim::robot_state_name(event.state),
-                 event.detail.c_str());
+    std::fprintf(stderr, "[robot] %.2f s %s: %s\n", static_cast<double>(event.tick) * dt,
+                 rfbsim::sim::robot_state_name(event.state), event.detail.c_str());
   }
 }
 
@@ -160,7 +160,7 @@ int run(const rfbsim::sim::SimOptions& options) {
     }
     for (int i = 0; i < ticks; ++i) {
       simulation.step();
-      log_robot_events(simulation.world());
+      log_robot_events(simulation.world(), simulation.params().dt);
     }
     const int clients = server.client_count();
     if (ticks > 0) status.publish(sim::status_json(simulation.world(), clients, frames_rendered));

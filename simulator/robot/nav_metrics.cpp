@@ -9,12 +9,6 @@ namespace rfbsim::sim {
 
 namespace {
 
-struct Body {
-  Eigen::Vector2d position;
-  Eigen::Vector2d velocity;
-  double radius;
-};
-
 }  // namespace
 
 void NavMetrics::observe(const World& world, double dt) {
@@ -25,8 +19,8 @@ void NavMetrics::observe(const World& world, double dt) {
   last_position_ = at;
 
   // Everyone the robot should treat as a person: the pedestrians and the participant's avatar.
-  std::vector<Body> bodies;
-  bodies.reserve(world.people.size() + 1);
+  std::vector<Body>& bodies = bodies_;
+  bodies.clear();
   for (const Person& p : world.people) bodies.push_back({{p.pose.x, p.pose.y}, p.velocity, p.radius});
   const Avatar& a = world.avatar;
   bodies.push_back({{a.pose.x, a.pose.y},

@@ -12,14 +12,15 @@
 
 namespace rfbsim::sim {
 
-/// Hall's zones by distance between the robot's and a person's centres, m.
+/// Hall's zones by distance between the robot's and a person's centres, and what counts as a collision.
 struct ZoneLimits {
-  double intimate = 0.45;
-  double personal = 1.2;
+  double intimate = 0.45;       ///< m
+  double personal = 1.2;        ///< m
   double collision_gap = 0.02;  ///< m between the bodies' surfaces: closer is a collision
   double still_speed = 0.01;    ///< m/s: slower counts as not moving
 };
 
+/// The measures of one run (REFERENCE.md, Social navigation metrics).
 struct NavSummary {
   double duration = 0.0;            ///< s observed
   double path_length = 0.0;         ///< m the robot travelled
@@ -36,6 +37,7 @@ struct NavSummary {
   int person_on_robot = 0;          ///< collisions begun while the person moved toward the robot faster
 };
 
+/// Accumulates NavSummary from the world, tick by tick.
 class NavMetrics {
  public:
   explicit NavMetrics(ZoneLimits limits = {}) : limits_(limits) {}
@@ -50,6 +52,12 @@ class NavMetrics {
   double closest_sum_ = 0.0;
   std::optional<Eigen::Vector2d> last_position_;
   std::vector<bool> touching_;  // per person (avatar last): in a collision at the last tick
+  struct Body {
+    Eigen::Vector2d position;
+    Eigen::Vector2d velocity;
+    double radius;
+  };
+  std::vector<Body> bodies_;  // this tick's people and avatar, reused
 };
 
 }  // namespace rfbsim::sim

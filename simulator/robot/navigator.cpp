@@ -2,6 +2,7 @@
 // Navigator: move_base's cycle (plan, control, goal check) and its recovery behaviours.
 #include "robot/navigator.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -61,7 +62,6 @@ std::optional<std::string> Navigator::set_goal(const Pose2& goal, const GridMap&
   goal_ = goal;
   fresh_goal_ = true;
   replan_now_ = true;
-  waiting_ = false;
   recovery_index_ = 0;
   enter(RobotState::Planning, "goal " + point(goal.x, goal.y));
   return std::nullopt;
@@ -99,6 +99,13 @@ NavCommand Navigator::cycle(double now, const Pose2& pose, double v, double w, c
     enter(RobotState::Arrived, fixed(distance) + " m from the goal");
     return {};
   }
+  // Not getting anywhere (dithering, waiting behind someone who does not move, or failing to face the
+  // goal's heading): recover.
+  if (params_.oscillation_timeout > 0.0 && now - last_progress_ > params_.oscillation_timeout) {
+    start_recovery(now, pose, "moved less than " + fixed(params_.oscillation_distance) + " m in " +
+                                  fixed(params_.oscillation_timeout, 0) + " s");
+    return state_ == RobotState::Recovering ? recover(now, pose, w, local) : NavCommand{};
+  }
   if (distance <= params_.xy_goal_tolerance) {
     // In place but facing the wrong way: turn to the goal's heading.
     const DwaCommand turn = dwa_.rotate_toward(local, pose, w, goal_->yaw);
@@ -116,13 +123,6 @@ NavCommand Navigator::cycle(double now, const Pose2& pose, double v, double w, c
       return state_ == RobotState::Recovering ? recover(now, pose, w, local) : NavCommand{};
     }
     if (path_.empty()) return {};
-  }
-
-  // Not getting anywhere (dithering, or waiting behind someone who does not move): recover.
-  if (params_.oscillation_timeout > 0.0 && now - last_progress_ > params_.oscillation_timeout) {
-    start_recovery(now, pose, "moved less than " + fixed(params_.oscillation_distance) + " m in " +
-                                  fixed(params_.oscillation_timeout, 0) + " s");
-    return state_ == RobotState::Recovering ? recover(now, pose, w, local) : NavCommand{};
   }
 
   // The way on lies behind or beside the robot: turn toward it in place first.
@@ -145,13 +145,13 @@ NavCommand Navigator::cycle(double now, const Pose2& pose, double v, double w, c
   ++times_.controls;
   if (command.found) {
     last_valid_control_ = now;
-    waiting_ = false;
     trajectory_ = command.trajectory;
     return {command.v, command.w, std::nullopt};
   }
+  // Yield: stop, and replan soon on the fresher costmap (move_base replans at once; at most twice a second
+  // here, as an A* over the warehouse costs up to a few ms).
   trajectory_.clear();
-  replan_now_ = true;
-  waiting_ = true;
+  replan_now_ = now - last_plan_time_ >= 0.5;
   if (now - last_valid_control_ > params_.controller_patience) {
     start_recovery(now, pose, "no legal velocity for " + fixed(now - last_valid_control_, 1) + " s: " + command.reason);
     return state_ == RobotState::Recovering ? recover(now, pose, w, local) : NavCommand{};
@@ -220,7 +220,7 @@ void Navigator::track_progress(double now, const Pose2& pose) {
 }
 
 void Navigator::start_recovery(double now, const Pose2& pose, std::string trigger) {
-  (void)now;
+  recovery_started_ = now;
   if (!params_.recovery_behavior_enabled || recovery_index_ >= kRecoverySteps) {
     path_.clear();
     trajectory_.clear();
@@ -255,7 +255,9 @@ NavCommand Navigator::recover(double now, const Pose2& pose, double w, const Cos
       // Rotate a full turn so the lidar sees all round, unless the costmap says turning would hit something.
       rotated_ += std::abs(angle_between(pose.yaw, last_yaw_));
       last_yaw_ = pose.yaw;
-      if (rotated_ >= kTwoPi - 0.1) {
+      // A full turn, or as long as a full turn should take (with margin) if the base cannot turn so far.
+      const double turn_time = kTwoPi / std::max(dwa_.params().max_vel_theta, 0.1) * 1.5 + 2.0;
+      if (rotated_ >= kTwoPi - 0.1 || now - recovery_started_ > turn_time) {
         finish();
         return {};
       }

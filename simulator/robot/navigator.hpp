@@ -28,10 +28,10 @@ struct NavEvent {
 
 /// Wall-clock cost of the planners so far (measurement only).
 struct NavigatorTimes {
-  double plan_seconds = 0.0;     ///< global planning
-  std::uint64_t plans = 0;
-  double control_seconds = 0.0;  ///< local planning (DWA)
-  std::uint64_t controls = 0;
+  double plan_seconds = 0.0;     ///< s spent in global planning
+  std::uint64_t plans = 0;       ///< global plans made
+  double control_seconds = 0.0;  ///< s spent in local planning (DWA)
+  std::uint64_t controls = 0;    ///< DWA cycles run
 };
 
 /// What one cycle asks of the rest of the robot.
@@ -42,6 +42,7 @@ struct NavCommand {
   std::optional<double> clear_obstacles_beyond;
 };
 
+/// move_base for one goal at a time: plan, control, goal check, recoveries (see the top of this file).
 class Navigator {
  public:
   Navigator(NavigatorParams params, GlobalPlannerParams planner, DwaParams dwa);
@@ -77,8 +78,8 @@ class Navigator {
   NavCommand recover(double now, const Pose2& pose, double w, const CostmapGrid& local);
   bool replan(double now, const Pose2& pose, const CostmapGrid& global);
   bool goal_reached(const Pose2& pose, bool goal_occupied) const;
-  /// World direction from the robot to the path point rotate_lookahead on from the nearest one; none
-  /// without a path or when the path ends within reach.
+  /// World direction from the robot to the path point rotate_lookahead on from the nearest one (the path's
+  /// last point when it ends nearer); none without a path of two points or more.
   std::optional<double> path_bearing(const Pose2& pose) const;
   void track_progress(double now, const Pose2& pose);
 
@@ -101,11 +102,11 @@ class Navigator {
   bool replan_now_ = true;
   bool fresh_goal_ = false;           // timers start at the first cycle after set_goal
   std::string plan_failure_;          // the global planner's last reason
-  bool waiting_ = false;              // stopped because DWA found nothing legal (yielding)
   // Recovery: which behaviour runs next, why recovery began, how far the current rotation has turned.
   int recovery_index_ = 0;
   std::string recovery_trigger_;
   double rotated_ = 0.0;
+  double recovery_started_ = 0.0;     // when the current recovery behaviour began, s
   double last_yaw_ = 0.0;
 };
 

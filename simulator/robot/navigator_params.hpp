@@ -5,6 +5,7 @@
 
 namespace rfbsim::sim {
 
+/// move_base's parameters (ROS names; defaults and deviations in docs/architecture.md, "The robot").
 struct NavigatorParams {
   double controller_frequency = 10.0;  ///< Hz: costmaps, local planning and commands (ROS 20; the issue's 10)
   /// Hz: the global plan is remade this often while moving, so it bends around people as they come

@@ -40,6 +40,7 @@ inline GlobalPlannerParams default_global_planner_params() {
   return params;
 }
 
+/// The robot's whole model: every part's parameters.
 struct RobotParams {
   DriveLimits drive;
   LidarParams lidar;
@@ -47,9 +48,10 @@ struct RobotParams {
   Localization localization = Localization::Amcl;
   AmclParams amcl;
   CostmapParams global_costmap = robot_global_costmap_params();
-  /// The local costmap inflates 0.25 m, not SEAN's 0.1 m: our DWA checks the robot's centre cell against
-  /// inscribed cost (a round robot's exact footprint test), which needs inflation past the 0.16 m radius;
-  /// ROS's DWA checked the footprint's outline against the map instead.
+  /// The local costmap inflates 0.45 m, not SEAN's 0.1 m: our DWA checks the robot's centre cell against
+  /// inscribed cost (a round robot's exact footprint test), which needs inflation past the padded radius
+  /// (ROS's DWA checked the footprint's outline against the map instead), and with occdist_scale 0.1 the
+  /// graded cost keeps the robot off walls and people rather than on the inscribed edge.
   CostmapParams local_costmap = local_costmap_params(0.45);
   /// Hz: how often the global costmap takes in the latest scan and people (ROS's update_frequency);
   /// the local one is updated every control cycle.

@@ -118,7 +118,10 @@ void RobotStack::step(World& world, double dt) {
   world.robot_events.clear();
   Robot& robot = *world.robot;
   const double now = world.time;
-  if (cycles_ == 0 && now >= next_cycle_time_) next_mission_goal(world);
+  if (!mission_started_) {
+    mission_started_ = true;
+    next_mission_goal(world);
+  }
 
   // Sense: the wheels count every tick; the lidar sweeps at its own rate, from the true pose.
   odometry_.update(robot.pose);
@@ -171,7 +174,8 @@ void RobotStack::control_cycle(World& world) {
     const LaserScan* scan = scan_fresh_ ? &scan_ : nullptr;
     local_.update(estimate, scan, seen_);
     if (now + 1e-9 >= next_global_update_) {
-      global_.update(estimate, &scan_, seen_);
+      // Only a scan taken this cycle: an older one marked from today's pose would leave ghosts.
+      global_.update(estimate, scan, seen_);
       next_global_update_ = std::max(next_global_update_ + 1.0 / setup_.params.global_update_frequency, now);
     }
     scan_fresh_ = false;
@@ -210,7 +214,9 @@ void RobotStack::control_cycle(World& world) {
   if (done && !goal_finished_) {
     goal_finished_ = true;
     if (kind == MissionSpec::Kind::Patrol || kind == MissionSpec::Kind::Wander) {
-      resume_mission_at_ = now + setup_.params.navigator.waypoint_pause;
+      // At least a second after a failure, so that a run of refused goals cannot flood the events.
+      const double pause = setup_.params.navigator.waypoint_pause;
+      resume_mission_at_ = now + (state == RobotState::Failed ? std::max(pause, 1.0) : pause);
     }
   }
 
@@ -241,6 +247,7 @@ void RobotStack::next_mission_goal(World& world) {
 std::optional<std::string> RobotStack::send_goal(World& world, const Pose2& goal) {
   resume_mission_at_ = -1.0;
   goal_finished_ = false;
+  mission_started_ = true;  // a goal sent before the first tick is not replaced by the mission's first
   auto refusal = navigator_.set_goal(goal, world.obstacles, world.robot->radius);
   world.robot->state = navigator_.state();
   return refusal;

@@ -39,6 +39,7 @@ struct StageTimes {
   std::array<std::uint64_t, static_cast<int>(NavStage::Count)> runs{};
 };
 
+/// The robot stage of the tick for one robot (see the top of this file).
 class RobotStack {
  public:
   /// Builds the stack for `world`'s robot (which must exist) in `world`'s obstacles map. Throws
@@ -88,6 +89,7 @@ class RobotStack {
   double next_global_update_ = 0.0;
   double resume_mission_at_ = -1.0;  // a pause at a waypoint ends then; < 0 = no pause
   bool goal_finished_ = false;       // the current goal was reached or failed, and the mission was told
+  bool mission_started_ = false;     // the mission's first goal was handed out (or a goal was sent)
   std::uint64_t cycles_ = 0;
   StageTimes times_;
   double head_target_ = 0.0;  // rad against the body, where the head should look

@@ -31,7 +31,7 @@ std::vector<Setting> settings(RobotParams& p) {
       // The base (REFERENCE.md: Kuri).
       {"drive", "max_vel_x", &p.drive.max_vel_x, 0.0, 5.0},
       {"drive", "min_vel_x", &p.drive.min_vel_x, -5.0, 0.0},
-      {"drive", "max_vel_theta", &p.drive.max_vel_theta, 0.0, 20.0},
+      {"drive", "max_vel_theta", &p.drive.max_vel_theta, 0.1, 20.0},
       {"drive", "acc_lim_x", &p.drive.acc_lim_x, 0.01, 50.0},
       {"drive", "acc_lim_theta", &p.drive.acc_lim_theta, 0.01, 100.0},
       {"drive", "footprint_padding", &p.footprint_padding, 0.0, 1.0},
@@ -104,13 +104,13 @@ std::vector<Setting> settings(RobotParams& p) {
       {"move_base", "conservative_reset_dist", &p.navigator.conservative_reset_dist, 0.0, 100.0},
       {"move_base", "aggressive_reset_dist", &p.navigator.aggressive_reset_dist, 0.0, 100.0},
       {"move_base", "xy_goal_tolerance", &p.navigator.xy_goal_tolerance, 0.01, 10.0},
-      {"move_base", "yaw_goal_tolerance", &p.navigator.yaw_goal_tolerance, 0.0, 10.0},
+      {"move_base", "yaw_goal_tolerance", &p.navigator.yaw_goal_tolerance, 0.01, 10.0},
       {"move_base", "waypoint_pause", &p.navigator.waypoint_pause, 0.0, 3600.0},
-      {"move_base", "rotate_to_path_angle", &p.navigator.rotate_to_path_angle, 0.0, 3.15},
+      {"move_base", "rotate_to_path_angle", &p.navigator.rotate_to_path_angle, 0.2, 3.15},
       // DWA local planner (ROS dwa_local_planner names).
       {"dwa", "max_vel_x", &p.dwa.max_vel_x, 0.0, 5.0},
       {"dwa", "min_vel_x", &p.dwa.min_vel_x, -5.0, 5.0},
-      {"dwa", "max_vel_theta", &p.dwa.max_vel_theta, 0.0, 20.0},
+      {"dwa", "max_vel_theta", &p.dwa.max_vel_theta, 0.1, 20.0},
       {"dwa", "min_vel_theta", &p.dwa.min_vel_theta, 0.0, 20.0},
       {"dwa", "min_vel_trans", &p.dwa.min_vel_trans, 0.0, 5.0},
       {"dwa", "acc_lim_x", &p.dwa.acc_lim_x, 0.01, 50.0},
@@ -183,6 +183,16 @@ void parse_robot_params(const YamlField& nav, RobotParams& params) {
     validate(params.global_costmap);
     validate(params.local_costmap);
     check_lidar_params(params.lidar);
+    if (const std::string error = dwa_params_error(params.dwa); !error.empty()) throw std::invalid_argument(error);
+    if (params.amcl.min_particles > params.amcl.max_particles) {
+      throw std::invalid_argument("amcl.min_particles must not exceed amcl.max_particles");
+    }
+    // DWA plans within the wheels' limits, or it would plan motions the base cannot make.
+    if (params.dwa.max_vel_x > params.drive.max_vel_x || params.dwa.min_vel_x < params.drive.min_vel_x ||
+        params.dwa.max_vel_theta > params.drive.max_vel_theta || params.dwa.acc_lim_x > params.drive.acc_lim_x ||
+        params.dwa.acc_lim_theta > params.drive.acc_lim_theta) {
+      throw std::invalid_argument("dwa's velocity and acceleration limits must lie within drive's");
+    }
   } catch (const std::invalid_argument& error) {
     nav.fail_with(error.what());
   }

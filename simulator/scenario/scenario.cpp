@@ -318,6 +318,10 @@ Scenario load_scenario(const std::filesystem::path& file) {
   if (auto robot = root.optional("robot")) {
     parse_robot(scenario, *robot);
     check_free(scenario, obstacles, scenario.robot.start, kRobotClearance, "robot.start", nullptr);
+    // Waypoints given as coordinates as well as by spawn name (those were checked with the spawns).
+    for (const Pose2& waypoint : scenario.robot.mission.waypoints) {
+      check_free(scenario, obstacles, waypoint, kRobotClearance, "robot.mission place", nullptr);
+    }
   }
   if (auto crowd = root.optional("crowd")) parse_crowd(scenario, obstacles, *crowd, seed_given);
   return scenario;

@@ -3,6 +3,8 @@
 // giving up with a reason when no route exists, and determinism.
 #include <catch2/catch.hpp>
 
+#include <cstring>
+
 #include "nav_run.hpp"
 
 namespace sim = rfbsim::sim;
@@ -75,8 +77,14 @@ TEST_CASE("nav: goals inside a wall or off the map are refused with a clear reas
   CHECK_THAT(*off_map, Catch::Contains("off the map"));
   const auto not_a_number = bare.stack().send_goal(world, {std::nan(""), 1.0, 0.0});
   REQUIRE(not_a_number);
-  // The refusal is reported as an event too, and the robot does not move.
+  CHECK_THAT(*not_a_number, Catch::Contains("not a number"));
+  // Each refusal is reported as an event too, with its reason, and the robot does not move.
   bare.step();
+  int failed_events = 0;
+  for (const auto& event : world.robot_events) {
+    if (event.state == sim::RobotState::Failed && event.detail.find("goal refused") != std::string::npos) ++failed_events;
+  }
+  CHECK(failed_events == 4);
   CHECK(world.robot->velocity.norm() < 1e-9);
   const auto fine = bare.stack().send_goal(world, {2.5, 2.5, 0.0});
   CHECK_FALSE(fine);
@@ -101,14 +109,57 @@ TEST_CASE("nav: with no route to the goal the robot recovers, then gives up with
 
 TEST_CASE("nav: the same seed drives the same path bit for bit, another seed another", "[nav]") {
   const sim::GridMap room = rfbsim::test::walled_room(10.0, 8.0);
-  const auto final_pose = [&](std::uint64_t seed) {
+  // The robot's true pose and estimate at every tick of 15 s.
+  const auto trace = [&](std::uint64_t seed) {
     BareWorld bare(rfbsim::test::bare_world(room, {1.5, 1.5, 0.3}, kParked),
                    rfbsim::test::goto_setup({8.0, 6.0, 0.0}, seed));
-    for (int i = 0; i < 15 * 60; ++i) bare.step();
-    const auto& r = *bare.world().robot;
-    return std::vector<double>{r.pose.x, r.pose.y, r.pose.yaw, r.estimate.x, r.estimate.y};
+    std::vector<double> poses;
+    for (int i = 0; i < 15 * 60; ++i) {
+      bare.step();
+      const auto& r = *bare.world().robot;
+      poses.insert(poses.end(), {r.pose.x, r.pose.y, r.pose.yaw, r.estimate.x, r.estimate.y, r.estimate.yaw});
+    }
+    return poses;
   };
-  const auto a = final_pose(5);
-  CHECK(a == final_pose(5));
-  CHECK(a != final_pose(6));
+  const auto a = trace(5);
+  const auto b = trace(5);
+  REQUIRE(a.size() == b.size());
+  CHECK(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+  CHECK(a != trace(6));
+}
+
+TEST_CASE("nav: a goal with a heading is reached facing it", "[nav]") {
+  const sim::GridMap room = rfbsim::test::walled_room(10.0, 8.0);
+  auto setup = rfbsim::test::goto_setup({7.0, 4.0, 1.5708});
+  setup.params.navigator.yaw_goal_tolerance = 0.2;
+  BareWorld bare(rfbsim::test::bare_world(room, {2.0, 4.0, 0.0}, kParked), setup);
+  const auto run = bare.run_to_goal(90.0);
+  REQUIRE(run.arrived);
+  CHECK(std::abs(std::remainder(bare.world().robot->pose.yaw - 1.5708, 2.0 * M_PI)) < 0.2 + 0.05);
+}
+
+TEST_CASE("nav: a patrol goes round its waypoints, pausing at each", "[nav]") {
+  const sim::GridMap room = rfbsim::test::walled_room(10.0, 8.0);
+  sim::RobotSetup setup;
+  setup.mission.kind = sim::MissionSpec::Kind::Patrol;
+  setup.mission.waypoints = {{2.0, 2.0, 0.0}, {7.0, 2.0, 0.0}, {7.0, 6.0, 0.0}};
+  setup.mission.waypoint_names = {"a", "b", "c"};
+  setup.params.navigator.waypoint_pause = 2.0;
+  BareWorld bare(rfbsim::test::bare_world(room, {2.0, 2.0, 0.0}, kParked), setup);
+  std::vector<double> arrivals;      // s
+  std::vector<double> next_plans;    // s: planning after an arrival
+  while (bare.world().time < 150.0 && arrivals.size() < 4) {
+    bare.step();
+    for (const auto& event : bare.world().robot_events) {
+      if (event.state == sim::RobotState::Arrived) arrivals.push_back(bare.world().time);
+      if (event.state == sim::RobotState::Planning && !arrivals.empty()) next_plans.push_back(bare.world().time);
+      CHECK(event.state != sim::RobotState::Failed);
+    }
+  }
+  // a (where it starts), b, c, and a again.
+  REQUIRE(arrivals.size() == 4);
+  REQUIRE(next_plans.size() >= 3);
+  for (std::size_t i = 0; i < 3; ++i) CHECK(next_plans[i] - arrivals[i] == Approx(2.0).margin(0.15));
+  const auto& r = *bare.world().robot;
+  CHECK(std::hypot(r.pose.x - 2.0, r.pose.y - 2.0) < 0.35 + 0.05);
 }

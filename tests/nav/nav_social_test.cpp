@@ -40,20 +40,34 @@ TEST_CASE("nav: passing a standing person in a corridor, the proxemic layer keep
   }
 }
 
-TEST_CASE("nav: a person blocking the short corridor makes the robot replan the long way round", "[nav][social]") {
-  // Two corridors between the west and east halls: a short one straight across (0.9 m wide) and a long
-  // one around the south. A person stands in the middle of the short one, leaving 0.2 m on either side.
+TEST_CASE("nav: people blocking the short corridor make the robot replan the long way round", "[nav][social]") {
+  // Two corridors between the west and east halls: a short one straight across (1.4 m wide) and a long
+  // one around the south. Two people wait in the north-east corner, out of everyone's way, and step side by
+  // side into the middle of the short corridor (leaving 0.15 m at either wall) once the robot has planned
+  // through it.
   sim::GridMap map = rfbsim::test::walled_room(16.0, 10.0);
-  rfbsim::test::add_wall(map, 5.0, 6.45, 11.0, 10.0);  // north of the short corridor
-  rfbsim::test::add_wall(map, 5.0, 2.5, 11.0, 5.55);   // between the two corridors
-  sim::World world = rfbsim::test::bare_world(map, {2.0, 6.0, 0.0}, {15.3, 9.3, 0.0});
-  world.people.push_back(rfbsim::test::standing_person(8.0, 6.0));
+  rfbsim::test::add_wall(map, 5.0, 6.7, 11.0, 10.0);  // north of the short corridor
+  rfbsim::test::add_wall(map, 5.0, 2.5, 11.0, 5.3);   // between the two corridors
+  sim::World world = rfbsim::test::bare_world(map, {2.0, 6.0, 0.0}, {15.3, 0.7, 0.0});
+  world.people.push_back(rfbsim::test::standing_person(13.5, 9.2, 1));
+  world.people.push_back(rfbsim::test::standing_person(14.5, 9.2, 2));
   BareWorld bare(std::move(world), rfbsim::test::goto_setup({14.0, 6.0, 0.0}));
+  std::vector<sim::RobotEvent> early;
+  for (int i = 0; i < 3 * 60; ++i) {
+    bare.step();
+    early.insert(early.end(), bare.world().robot_events.begin(), bare.world().robot_events.end());
+  }
+  // The first plan runs through the short corridor: about 12 m.
+  REQUIRE(early.size() >= 2);
+  CHECK(early[1].state == sim::RobotState::Moving);
+  CHECK_THAT(early[1].detail, Catch::Contains("following a 12.") || Catch::Contains("following a 11."));
+  bare.world_mut().people[0].pose = {8.0, 5.7, 0.0};
+  bare.world_mut().people[1].pose = {8.0, 6.3, 0.0};
   const auto run = bare.run_to_goal(240.0);
   INFO(run.last_detail);
   REQUIRE(run.arrived);
   CHECK(run.metrics.robot_on_person == 0);
-  // The short way is 12 m; the long way round the south corridor is over 17 m.
+  // The robot went the long way round the south corridor: over 15 m driven, where the short way is 12 m.
   CHECK(run.metrics.path_length > 15.0);
   CHECK_FALSE(run.hit_wall);
 }

@@ -16,8 +16,9 @@ namespace rfbsim::sim {
 
 namespace {
 
-// Why a parameter set cannot work, or empty.
-std::string check_params(const DwaParams& p) {
+}  // namespace
+
+std::string dwa_params_error(const DwaParams& p) {
   const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
   const auto non_negative = [](double x) { return std::isfinite(x) && x >= 0.0; };
   if (!std::isfinite(p.max_vel_x) || !std::isfinite(p.min_vel_x) || p.min_vel_x > p.max_vel_x) {
@@ -42,6 +43,8 @@ std::string check_params(const DwaParams& p) {
   return {};
 }
 
+namespace {
+
 // Deterministic preference among equal scores: faster, then straighter, then turning left.
 bool preferred(double score, double v, double w, double best_score, double best_v, double best_w) {
   if (score != best_score) return score < best_score;
@@ -54,7 +57,7 @@ bool preferred(double score, double v, double w, double best_score, double best_
 
 DwaPlanner::DwaPlanner(DwaParams params)
     : params_(params),
-      params_error_(check_params(params)),
+      params_error_(dwa_params_error(params)),
       oscillation_(params.oscillation_reset_dist, params.oscillation_reset_angle, params.min_vel_trans),
       people_(params.robot_radius, params.people_clearance, params.people_horizon, params.sim_time),
       path_("path_distance", MapDistanceCritic::Target::Path, 0.0, false),

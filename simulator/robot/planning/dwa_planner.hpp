@@ -108,6 +108,9 @@ class DwaPlanner {
   }
 };
 
+/// Why a DWA parameter set cannot work ("bad DWA parameters: need finite min_vel_x <= max_vel_x"), or empty.
+std::string dwa_params_error(const DwaParams& params);
+
 /// Whether `pose` is within `xy_goal_tolerance` (m) of `goal`; false for non-finite input.
 bool within_xy_tolerance(const Pose2& pose, const Eigen::Vector2d& goal, double xy_goal_tolerance);
 
