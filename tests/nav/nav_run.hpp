@@ -32,7 +32,9 @@ struct NavRun {
   bool hit_wall = false;
 };
 
-/// Watches a world tick by tick: events, metrics, localization error, wall clearance.
+/// Watches a world tick by tick: events, metrics, localization error, wall clearance. For debugging a run,
+/// RFBSIM_NAV_TRACE=1 prints the robot once a simulated second and every robot-at-fault collision; =2 adds
+/// the global path and the chosen trajectory.
 class NavWatch {
  public:
   /// Takes one stepped tick; returns true once the robot arrived or failed.
