@@ -185,6 +185,24 @@ GridMap grid_from_text(std::initializer_list<std::string_view> rows_top_first, d
   return map;
 }
 
+GridMap walled_grid(double width, double height, double res, const std::vector<WallBlock>& blocks) {
+  GridMap map;
+  map.width = static_cast<int>(std::lround(width / res));
+  map.height = static_cast<int>(std::lround(height / res));
+  map.resolution = res;
+  map.occupied.assign(static_cast<std::size_t>(map.width * map.height), 0);
+  for (int row = 0; row < map.height; ++row) {
+    for (int col = 0; col < map.width; ++col) {
+      bool wall = row == 0 || col == 0 || row == map.height - 1 || col == map.width - 1;
+      const double x = (col + 0.5) * res;
+      const double y = (row + 0.5) * res;
+      for (const WallBlock& b : blocks) wall = wall || (x > b.x && x < b.x + b.w && y > b.y && y < b.y + b.h);
+      map.occupied[static_cast<std::size_t>(row * map.width + col)] = wall ? 1 : 0;
+    }
+  }
+  return map;
+}
+
 GridMap builtin_test_room() {
   // 24 x 18 cells of 0.5 m, centred on the origin: an outer wall, an inner wall with a doorway, a pillar.
   GridMap map = grid_from_text(

@@ -73,6 +73,18 @@ std::vector<WallRect> merge_wall_rectangles(const GridMap& map);
 /// Throws std::invalid_argument if rows differ in length or there are none.
 GridMap grid_from_text(std::initializer_list<std::string_view> rows_top_first, double resolution);
 
+/// A block of wall in walled_grid, world metres (lower-left corner and size).
+struct WallBlock {
+  double x = 0.0;
+  double y = 0.0;
+  double w = 0.0;
+  double h = 0.0;
+};
+
+/// A `width` x `height` m grid of `res` m cells with its origin at (0, 0), a one-cell wall all round, and
+/// every cell whose centre lies strictly inside one of `blocks` blocked (tests and small examples).
+GridMap walled_grid(double width, double height, double res, const std::vector<WallBlock>& blocks = {});
+
 /// The small built-in room: 12 m x 9 m with an inner wall (tests and the demo without a scenario).
 GridMap builtin_test_room();
 

@@ -159,25 +159,28 @@ NavCommand Navigator::cycle(double now, const Pose2& pose, double v, double w, c
   return {};
 }
 
-std::optional<double> Navigator::path_bearing(const Pose2& pose) const {
-  if (path_.size() < 2) return std::nullopt;
-  const Eigen::Vector2d at(pose.x, pose.y);
+std::optional<Eigen::Vector2d> point_ahead(const std::vector<Eigen::Vector2d>& path, const Eigen::Vector2d& from,
+                                           double distance) {
+  if (path.size() < 2) return std::nullopt;
   std::size_t nearest = 0;
   double best = 1e18;
-  for (std::size_t i = 0; i < path_.size(); ++i) {
-    const double d = (path_[i] - at).squaredNorm();
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const double d = (path[i] - from).squaredNorm();
     if (d < best) {
       best = d;
       nearest = i;
     }
   }
-  for (std::size_t i = nearest + 1; i < path_.size(); ++i) {
-    const Eigen::Vector2d offset = path_[i] - at;
-    if (offset.norm() >= params_.rotate_lookahead || i + 1 == path_.size()) {
-      return std::atan2(offset.y(), offset.x());
-    }
+  for (std::size_t i = nearest + 1; i < path.size(); ++i) {
+    if ((path[i] - from).norm() >= distance || i + 1 == path.size()) return path[i];
   }
   return std::nullopt;
+}
+
+std::optional<double> Navigator::path_bearing(const Pose2& pose) const {
+  const auto ahead = point_ahead(path_, {pose.x, pose.y}, params_.rotate_lookahead);
+  if (!ahead) return std::nullopt;
+  return std::atan2(ahead->y() - pose.y, ahead->x() - pose.x);
 }
 
 bool Navigator::goal_reached(const Pose2& pose, bool goal_occupied) const {

@@ -42,6 +42,12 @@ struct NavCommand {
   std::optional<double> clear_obstacles_beyond;
 };
 
+/// The first point of `path` at least `distance` m from `from`, after the path's point nearest `from`
+/// (the path's last point when none is that far); none when the path has fewer than two points or its
+/// nearest point is its last. What the robot turns toward, and what its head looks at.
+std::optional<Eigen::Vector2d> point_ahead(const std::vector<Eigen::Vector2d>& path, const Eigen::Vector2d& from,
+                                           double distance);
+
 /// move_base for one goal at a time: plan, control, goal check, recoveries (see the top of this file).
 class Navigator {
  public:

@@ -48,23 +48,6 @@ Eigen::Vector2d believed(const Eigen::Vector2d& point, const Pose2& truth, const
   return turn * (point - Eigen::Vector2d(truth.x, truth.y)) + Eigen::Vector2d(estimate.x, estimate.y);
 }
 
-/// The point `distance` m along `path` from its point nearest `from` (the path's end if it is shorter).
-Eigen::Vector2d look_ahead(const std::vector<Eigen::Vector2d>& path, const Eigen::Vector2d& from, double distance) {
-  std::size_t nearest = 0;
-  double best = 1e18;
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    const double d = (path[i] - from).squaredNorm();
-    if (d < best) {
-      best = d;
-      nearest = i;
-    }
-  }
-  for (std::size_t i = nearest; i + 1 < path.size(); ++i) {
-    if ((path[i + 1] - from).norm() >= distance) return path[i + 1];
-  }
-  return path.back();
-}
-
 /// The setup with the parameters that must agree made to agree: DWA's window is one control period wide,
 /// and the costmaps' footprint is the robot's body plus the padding.
 RobotSetup synced(RobotSetup setup, double robot_radius) {
@@ -229,7 +212,8 @@ void RobotStack::control_cycle(World& world) {
   head_target_ = 0.0;
   if (!robot.nav.global_path.empty()) {
     const Eigen::Vector2d ahead =
-        look_ahead(robot.nav.global_path, {estimate.x, estimate.y}, setup_.params.head_lookahead);
+        point_ahead(robot.nav.global_path, {estimate.x, estimate.y}, setup_.params.head_lookahead)
+            .value_or(robot.nav.global_path.back());
     const double bearing = std::atan2(ahead.y() - estimate.y, ahead.x() - estimate.x);
     const double limit = setup_.params.head_max_angle;
     head_target_ = std::clamp(std::remainder(bearing - estimate.yaw, 2.0 * std::numbers::pi), -limit, limit);

@@ -39,10 +39,10 @@ class NavWatch {
  public:
   /// Takes one stepped tick; returns true once the robot arrived or failed.
   bool observe(const sim::World& world, double dt) {
-    const int faults_before = metrics_.summary().robot_on_person;
+    const int faults_before = trace_ ? metrics_.summary().robot_on_person : 0;
     metrics_.observe(world, dt);
     const sim::Robot& robot = *world.robot;
-    if (std::getenv("RFBSIM_NAV_TRACE") && metrics_.summary().robot_on_person != faults_before) {
+    if (trace_ && metrics_.summary().robot_on_person != faults_before) {
       std::fprintf(stderr, "COLLISION t %.2f robot %.2f %.2f yaw %.2f vel %.2f %.2f state %s\n", world.time, robot.pose.x,
                    robot.pose.y, robot.pose.yaw, robot.velocity.x(), robot.velocity.y(), sim::robot_state_name(robot.state));
       for (const auto& p : world.people) {
@@ -60,12 +60,12 @@ class NavWatch {
       if (event.state == sim::RobotState::Failed) run_.failed = true;
     }
     run_.end_time = world.time;
-    if (std::getenv("RFBSIM_NAV_TRACE") && world.tick % 60 == 0) {
+    if (trace_ && world.tick % 60 == 0) {
       std::fprintf(stderr, "t %6.1f pose %6.2f %6.2f %5.2f est %6.2f %6.2f v %5.2f w %5.2f state %s path %zu traj %zu\n",
                    world.time, robot.pose.x, robot.pose.y, robot.pose.yaw, robot.estimate.x, robot.estimate.y,
                    robot.velocity.norm(), robot.yaw_rate, sim::robot_state_name(robot.state),
                    robot.nav.global_path.size(), robot.nav.local_trajectory.size());
-      if (std::getenv("RFBSIM_NAV_TRACE")[0] == '2' && !robot.nav.global_path.empty()) {
+      if (trace_paths_ && !robot.nav.global_path.empty()) {
         std::fprintf(stderr, "  path:");
         for (std::size_t i = 0; i < robot.nav.global_path.size(); i += 10) std::fprintf(stderr, " (%.2f,%.2f)", robot.nav.global_path[i].x(), robot.nav.global_path[i].y());
         std::fprintf(stderr, "\n  traj:");
@@ -83,6 +83,9 @@ class NavWatch {
   }
 
  private:
+  const char* trace_switch_ = std::getenv("RFBSIM_NAV_TRACE");
+  bool trace_ = trace_switch_ != nullptr;
+  bool trace_paths_ = trace_ && trace_switch_[0] == '2';
   NavRun run_;
   sim::NavMetrics metrics_;
 };
@@ -145,18 +148,7 @@ class BareWorld {
 
 /// An open rectangle width x height m at `resolution`, walled all round one cell thick.
 inline sim::GridMap walled_room(double width, double height, double resolution = 0.05) {
-  sim::GridMap map;
-  map.resolution = resolution;
-  map.width = static_cast<int>(std::lround(width / resolution));
-  map.height = static_cast<int>(std::lround(height / resolution));
-  map.occupied.assign(static_cast<std::size_t>(map.width) * static_cast<std::size_t>(map.height), 0);
-  for (int row = 0; row < map.height; ++row) {
-    for (int col = 0; col < map.width; ++col) {
-      const bool border = row == 0 || col == 0 || row == map.height - 1 || col == map.width - 1;
-      if (border) map.occupied[static_cast<std::size_t>(row * map.width + col)] = 1;
-    }
-  }
-  return map;
+  return sim::walled_grid(width, height, resolution);
 }
 
 /// Blocks the axis-aligned box [x0, x1] x [y0, y1] (m) of `map`.

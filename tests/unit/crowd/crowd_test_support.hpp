@@ -12,29 +12,11 @@
 namespace rfbsim::sim::test {
 
 /// A block of wall, world metres (lower-left corner and size).
-struct Block {
-  double x = 0.0;
-  double y = 0.0;
-  double w = 0.0;
-  double h = 0.0;
-};
+using Block = WallBlock;
 
 /// A world with a `width` x `height` m room: a one-cell wall border and the given blocks, on a `res` grid.
 inline World walled_world(double width, double height, double res, const std::vector<Block>& blocks = {}) {
-  GridMap map;
-  map.width = static_cast<int>(std::lround(width / res));
-  map.height = static_cast<int>(std::lround(height / res));
-  map.resolution = res;
-  map.occupied.assign(static_cast<std::size_t>(map.width * map.height), 0);
-  for (int row = 0; row < map.height; ++row) {
-    for (int col = 0; col < map.width; ++col) {
-      bool wall = row == 0 || col == 0 || row == map.height - 1 || col == map.width - 1;
-      const double x = (col + 0.5) * res;
-      const double y = (row + 0.5) * res;
-      for (const Block& b : blocks) wall = wall || (x > b.x && x < b.x + b.w && y > b.y && y < b.y + b.h);
-      map.occupied[static_cast<std::size_t>(row * map.width + col)] = wall ? 1 : 0;
-    }
-  }
+  const GridMap map = walled_grid(width, height, res, blocks);
   World world;
   world.map = map;
   world.obstacles = map;

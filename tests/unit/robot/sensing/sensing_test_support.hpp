@@ -13,31 +13,12 @@
 namespace rfbsim::sim::test {
 
 /// A block of wall, world metres (lower-left corner and size).
-struct Block {
-  double x = 0.0;
-  double y = 0.0;
-  double w = 0.0;
-  double h = 0.0;
-};
+using Block = WallBlock;
 
 /// A `width` x `height` m map with a one-cell wall all round and the given blocks (cells whose centre lies
 /// inside a block), on a `res` grid with its origin at (0, 0).
 inline GridMap walled_room(double width, double height, double res, const std::vector<Block>& blocks = {}) {
-  GridMap map;
-  map.width = static_cast<int>(std::lround(width / res));
-  map.height = static_cast<int>(std::lround(height / res));
-  map.resolution = res;
-  map.occupied.assign(static_cast<std::size_t>(map.width * map.height), 0);
-  for (int row = 0; row < map.height; ++row) {
-    for (int col = 0; col < map.width; ++col) {
-      bool wall = row == 0 || col == 0 || row == map.height - 1 || col == map.width - 1;
-      const double x = (col + 0.5) * res;
-      const double y = (row + 0.5) * res;
-      for (const Block& b : blocks) wall = wall || (x > b.x && x < b.x + b.w && y > b.y && y < b.y + b.h);
-      map.occupied[static_cast<std::size_t>(row * map.width + col)] = wall ? 1 : 0;
-    }
-  }
-  return map;
+  return walled_grid(width, height, res, blocks);
 }
 
 /// An 8 x 6 m room at 0.05 m with boxes, a pillar and wall stubs placed without symmetry, so that a lidar
