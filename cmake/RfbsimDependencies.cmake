@@ -8,10 +8,10 @@ find_package(Eigen3 3.3 REQUIRED NO_MODULE)          # Eigen3::Eigen
 find_package(yaml-cpp 0.7 REQUIRED CONFIG)           # yaml-cpp (scenario files, map_server YAML)
 pkg_check_modules(ODE REQUIRED IMPORTED_TARGET ode)  # PkgConfig::ODE (ODE has no CMake config)
 pkg_check_modules(PNG REQUIRED IMPORTED_TARGET libpng)  # PkgConfig::PNG (map images)
-if(RFBSIM_BUILD_TESTS OR RFBSIM_BUILD_BENCH)
-  find_package(websocketpp CONFIG REQUIRED)          # websocketpp::websocketpp (header-only)
-  find_package(Boost REQUIRED COMPONENTS system)     # websocketpp's asio transport
-endif()
+find_package(websocketpp CONFIG REQUIRED)            # websocketpp::websocketpp (header-only): sim_manager, tests
+find_package(Boost REQUIRED COMPONENTS system)       # websocketpp's asio transport
+find_package(OpenSSL 3 REQUIRED)                     # OpenSSL::SSL, OpenSSL::Crypto: TLS, signed links, tokens
+find_package(SQLite3 REQUIRED)                       # SQLite::SQLite3: sim_manager's session index
 if(RFBSIM_BUILD_TESTS)
   find_package(Catch2 2 REQUIRED)
   include(Catch)

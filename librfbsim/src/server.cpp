@@ -47,6 +47,7 @@ using Clock = std::chrono::steady_clock;
 
 // How long a silent new connection may take to show whether it speaks HTTP. Raw RFB clients wait for the
 // server to speak first, so they are only recognised by this timeout; browsers send their request at once.
+// A server with nothing to serve over HTTP skips this wait (see Impl::serves_http).
 constexpr auto kSniffTimeout = std::chrono::milliseconds(500);
 // Poll timeout when nothing is pending; only bounds how fast the thread notices a stop request.
 constexpr int kIdlePollMs = 200;
@@ -166,6 +167,9 @@ struct Server::Impl {
   static void on_update_done(rfbClientPtr cl, int result);
 
   ServerOptions options;
+  // Whether plain HTTP has anything to get here (a web root or a json route). Without it every new
+  // connection goes to libvncserver at once: sniffing would only delay raw RFB clients by kSniffTimeout.
+  bool serves_http = false;
   detail::Listener listener;
   int wake_fd = -1;
   rfbScreenInfoPtr screen = nullptr;
@@ -196,6 +200,7 @@ struct Server::Impl {
 
 Server::Impl::Impl(ServerOptions o)
     : options(validated(std::move(o))),
+      serves_http(!options.web_root.empty() || !options.json_routes.empty()),
       mailbox(options.width, options.height),
       damage(options.width, options.height) {
   // libvncserver reports ordinary disconnects ("read: Connection reset by peer") on its error channel
@@ -378,6 +383,12 @@ void Server::Impl::accept_new() {
   for (;;) {
     const int fd = ::accept4(listener.fd, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
     if (fd < 0) return;  // EAGAIN: no more; other errors (EMFILE...) are retried on the next wake
+    // Nothing HTTP to serve: whatever the peer speaks is libvncserver's to take (RFB, RFB over WebSocket)
+    // or to refuse (a plain HTTP request, garbage), as if it owned the port.
+    if (!serves_http) {
+      adopt_rfb(fd);
+      continue;
+    }
     pending.push_back({fd, Clock::now()});
   }
 }

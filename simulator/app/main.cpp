@@ -3,10 +3,15 @@
 //
 // The main thread is the simulation thread: it owns the GL context, steps the world at a fixed rate,
 // and renders at the frame rate only while someone is watching. librfbsim's own thread does the network.
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -37,6 +42,44 @@ void install_signal_handlers() {
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  // A reader that went away (sim_manager's ready pipe, a client socket) must show up as EPIPE from the
+  // write, which we report, not as a signal that ends the process without a word.
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGPIPE, &ignore, nullptr);
+}
+
+// --ready-fd must name a descriptor our parent opened for writing. Checked before we open anything:
+// were it closed, the number could later be reused by one of our own sockets, and the ready line would
+// go there. Throws std::runtime_error naming the problem.
+void check_ready_fd(int fd) {
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags < 0) {
+    throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": not an open file descriptor (" +
+                             std::strerror(errno) + ")");
+  }
+  if ((flags & O_ACCMODE) == O_RDONLY) {
+    throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": open for reading only");
+  }
+}
+
+// Tells the parent that the port is open: one line "ready <port>\n" on `fd`, which is then closed so that
+// the parent's read sees the end. Throws std::runtime_error when the write fails (EPIPE: the parent left).
+void report_ready(int fd, int port) {
+  const std::string line = "ready " + std::to_string(port) + "\n";
+  std::size_t written = 0;
+  while (written < line.size()) {
+    const auto n = ::write(fd, line.data() + written, line.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string cause = n < 0 ? std::strerror(errno) : "nothing written";
+      ::close(fd);
+      throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": cannot write the ready line (" + cause + ")");
+    }
+    written += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
 }
 
 // The page: --web-root if given, else the one built beside this binary, else the installed one.
@@ -103,6 +146,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   using Clock = std::chrono::steady_clock;
   namespace sim = rfbsim::sim;
 
+  if (options.ready_fd) check_ready_fd(*options.ready_fd);
   // The scenario first: a broken one ends the program before anything listens.
   const std::unique_ptr<sim::Simulation> simulation_owner = make_simulation(options);
   sim::Simulation& simulation = *simulation_owner;
@@ -116,8 +160,12 @@ int run(const rfbsim::sim::SimOptions& options) {
   server_options.jpeg_quality = options.jpeg_quality;
   server_options.max_clients = options.max_clients;
   server_options.desktop_name = "rfbsim";
-  server_options.web_root = find_web_root(options.web_root);
-  server_options.json_routes["/status.json"] = [&status] { return status.read(); };
+  // RFB only: no web root and no route, which librfbsim takes to mean no HTTP at all, so that a raw RFB
+  // client (sim_manager's relay) is served at once instead of after the wait that tells it from a browser.
+  if (!options.rfb_only) {
+    server_options.web_root = find_web_root(options.web_root);
+    server_options.json_routes["/status.json"] = [&status] { return status.read(); };
+  }
   server_options.on_connect = [](const rfbsim::ClientInfo& c) {
     std::fprintf(stderr, "[sim_rfb] client %d connected from %s (%s)\n", c.id, c.address.c_str(),
                  c.websocket ? "websocket" : "rfb");
@@ -144,6 +192,8 @@ int run(const rfbsim::sim::SimOptions& options) {
 
   // Readers of /status.json never see an empty document, even before the first tick.
   status.publish(sim::status_json(simulation.world(), 0, 0));
+  // The parent's line first: if it cannot be told, we are not ready, and stdout should not say we are.
+  if (options.ready_fd) report_ready(*options.ready_fd, server.port());
   std::printf("sim_rfb ready: %s\n", server.url().c_str());
   std::fflush(stdout);
 
@@ -163,7 +213,9 @@ int run(const rfbsim::sim::SimOptions& options) {
       log_robot_events(simulation.world(), simulation.params().dt);
     }
     const int clients = server.client_count();
-    if (ticks > 0) status.publish(sim::status_json(simulation.world(), clients, frames_rendered));
+    if (ticks > 0 && !options.rfb_only) {
+      status.publish(sim::status_json(simulation.world(), clients, frames_rendered));
+    }
 
     // Render only for a viewer, at the frame rate.
     if (clients == 0) {

@@ -3,6 +3,7 @@
 #include "app/options.hpp"
 
 #include <charconv>
+#include <climits>
 #include <functional>
 #include <map>
 
@@ -27,7 +28,7 @@ std::string sim_usage() {
          "               [--scenario NAME|PATH] [--avatar-start P] [--avatar-goal P] [--robot-start P]\n"
          "               [--robot-goal P] [--crowd N]\n"
          "               [--quality Q] [--max-clients N] [--web-root DIR] [--egl auto|device|surfaceless]\n"
-         "               [--debug-overlay]\n"
+         "               [--debug-overlay] [--rfb-only] [--ready-fd N]\n"
          "  --port N         TCP port for the page, WebSocket and RFB (default 5901; 0 = any free port)\n"
          "  --bind ADDR      numeric address to listen on (default 127.0.0.1)\n"
          "  --width W        frame width in pixels, 160..3840 (default 1280)\n"
@@ -43,7 +44,11 @@ std::string sim_usage() {
          "  --web-root DIR   directory holding the participant page (default: the built page)\n"
          "  --egl P          EGL platform (default auto: GPU device, else Mesa surfaceless)\n"
          "  --debug-overlay  draw the robot's global path, local trajectory, goal, pose estimate and social\n"
-         "                   cost on the floor (for developers; participants should not see it)\n";
+         "                   cost on the floor (for developers; participants should not see it)\n"
+         "  --rfb-only       serve RFB only (raw and over WebSocket): no page, no /status.json; a raw RFB\n"
+         "                   client is then served at once instead of after 0.5 s (for sim_manager's relay)\n"
+         "  --ready-fd N     once listening, write 'ready PORT' and a newline to file descriptor N (3 or\n"
+         "                   above, e.g. a pipe from the parent) and close it; exit 1 if that write fails\n";
 }
 
 ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
@@ -76,6 +81,13 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
       {"--quality", [&](const std::string& v) { return parse_number(v, 1, 100, o.jpeg_quality); }},
       {"--max-clients", [&](const std::string& v) { return parse_number(v, 1, 64, o.max_clients); }},
       {"--web-root", [&](const std::string& v) { o.web_root = v; return !v.empty(); }},
+      {"--ready-fd", [&](const std::string& v) {
+         // 0, 1 and 2 are stdin, stdout and stderr: writing the ready line there is surely a mistake.
+         int fd = 0;
+         if (!parse_number(v, 3, INT_MAX, fd)) return false;
+         o.ready_fd = fd;
+         return true;
+       }},
       {"--egl", [&](const std::string& v) {
          o.egl_platform = v;
          return v == "auto" || v == "device" || v == "surfaceless";
@@ -89,6 +101,10 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
     }
     if (arg == "--debug-overlay") {
       o.debug_overlay = true;
+      continue;
+    }
+    if (arg == "--rfb-only") {
+      o.rfb_only = true;
       continue;
     }
     auto option = with_value.find(arg);
@@ -106,6 +122,8 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
       return outcome;
     }
   }
+  // Without HTTP there is no page to serve: a web root given anyway shows a misunderstanding.
+  if (o.rfb_only && !o.web_root.empty()) outcome.error = "--rfb-only serves no page; drop --web-root";
   return outcome;
 }
 

@@ -27,6 +27,10 @@ struct SimOptions {
   std::string web_root;             ///< empty = the built or installed page
   std::string egl_platform = "auto";
   bool debug_overlay = false;       ///< draw the robot's path, trajectory, goal and social cost (for developers)
+  /// Serve RFB only (raw and over WebSocket): no page, no /status.json, no web root looked for.
+  bool rfb_only = false;
+  /// Once listening, write "ready <port>\n" to this file descriptor (3 or above) and close it.
+  std::optional<int> ready_fd;
   bool help = false;
 };
 

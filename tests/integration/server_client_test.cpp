@@ -3,6 +3,8 @@
 #include <catch2/catch.hpp>
 
 #include <atomic>
+#include <chrono>
+#include <cstdio>
 #include <memory>
 #include <thread>
 
@@ -202,4 +204,34 @@ TEST_CASE("JSON routes answer on the same port as RFB") {
   CHECK(rfbsim::test::http_body(response) == "{\"ok\":1}");
   CHECK(rfbsim::test::http_get(server.port(), "/").rfind("HTTP/1.1 404", 0) == 0);
   CHECK(server.stats().http_requests == 2);
+}
+
+TEST_CASE("a server without web root or json routes hands every connection to RFB at once") {
+  // Nothing to serve over HTTP, so no wait to tell a silent raw RFB client from a browser.
+  rfbsim::Server server(small_server(128, 64));
+  const auto blue = solid(128, 64, 0, 0, 220);
+  server.submit({blue.data(), 128, 64, 0});
+
+  // A raw RFB client speaks only after the greeting: it is served without sending anything first.
+  const auto started = std::chrono::steady_clock::now();
+  RfbTestClient client("127.0.0.1", server.port());
+  const auto handshake = std::chrono::steady_clock::now() - started;
+  REQUIRE(client.pump_until([&] { return client.frame().row(32)[64 * 4 + 2] > 150; }, 5s));
+  // Printed, not asserted: the handshake skips the 500 ms sniff (libvncserver's own ~100 ms WebSocket
+  // check remains).
+  std::printf("[server_client_test] RFB-only handshake took %lld ms\n",
+              static_cast<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(handshake).count()));
+
+  // A plain HTTP request has no page to get: libvncserver drops it as a bad client, and nothing answers.
+  const std::string response = rfbsim::test::http_get(server.port(), "/status.json");
+  CHECK(response.find("HTTP/1.1 200") == std::string::npos);
+  CHECK(server.stats().http_requests == 0);
+
+  // The server serves on: the first client still gets new frames, a second one gets the picture.
+  const auto red = solid(128, 64, 220, 0, 0);
+  server.submit({red.data(), 128, 64, 0});
+  CHECK(client.pump_until([&] { return client.frame().row(32)[64 * 4] > 150; }, 5s));
+  RfbTestClient again("127.0.0.1", server.port());
+  CHECK(again.pump_until([&] { return again.frame().row(32)[64 * 4] > 150; }, 5s));
+  CHECK(server.client_count() == 2);
 }

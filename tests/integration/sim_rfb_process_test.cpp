@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// sim_rfb as a real process: a real RFB client walks the avatar; command-line and setup errors.
+// sim_rfb as a real process: a real RFB client walks the avatar; command-line and setup errors;
+// --rfb-only and --ready-fd as sim_manager uses them.
 #include <sys/wait.h>
 
 #include <catch2/catch.hpp>
 
+#include <fcntl.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -11,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <regex>
 #include <thread>
 
 #include "rfb_test_client.hpp"
@@ -42,6 +46,121 @@ bool await_status(const SimProcess& sim, RfbTestClient* client, Done done, std::
 }
 
 const std::vector<std::string> kSmall = {"--port", "0", "--width", "320", "--height", "240"};
+
+// What sim_rfb finds as descriptor 3.
+enum class Fd3 {
+  kPipe,        // the write end of a pipe whose read end the test holds (what sim_manager does)
+  kClosed,      // nothing
+  kReaderGone,  // the write end of a pipe whose read end is already closed
+};
+
+enum class ReadOutcome { kDone, kEnd, kTimeout };
+
+// Appends what `fd` yields to `text` until `done(text)` holds, the end of the pipe (every writer closed
+// it) or `timeout`, and says which came first.
+template <typename Done>
+ReadOutcome read_until(int fd, std::string& text, Done done, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!done(text)) {
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    pollfd pfd{fd, POLLIN, 0};
+    if (left.count() <= 0 || ::poll(&pfd, 1, static_cast<int>(left.count())) <= 0) return ReadOutcome::kTimeout;
+    char buffer[512];
+    const auto n = ::read(fd, buffer, sizeof buffer);
+    if (n <= 0) return ReadOutcome::kEnd;
+    text.append(buffer, static_cast<std::size_t>(n));
+  }
+  return ReadOutcome::kDone;
+}
+
+// Reads `fd` to the end of the pipe within `timeout`; returns whether the end came.
+bool read_to_end(int fd, std::string& text, std::chrono::milliseconds timeout) {
+  return read_until(fd, text, [](const std::string&) { return false; }, timeout) == ReadOutcome::kEnd;
+}
+
+// sim_rfb started the way sim_manager starts it: descriptor 3 set up as `fd3` says, stdout and stderr
+// into one pipe (fork, dup2, execv; no shell). SimProcess cannot hand over descriptor 3, and it waits
+// for an http:// ready line, which --rfb-only does not print.
+class ManagedSim {
+ public:
+  ManagedSim(const std::vector<std::string>& args, Fd3 fd3) {
+    std::vector<std::string> argv_strings{rfbsim::test::sim_rfb_path()};
+    argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& arg : argv_strings) argv.push_back(arg.data());
+    argv.push_back(nullptr);
+    int output[2];
+    int ready[2];
+    REQUIRE(::pipe2(output, O_CLOEXEC) == 0);
+    REQUIRE(::pipe2(ready, O_CLOEXEC) == 0);
+    pid_ = ::fork();
+    REQUIRE(pid_ >= 0);
+    if (pid_ == 0) {
+      // Only async-signal-safe calls until execv. dup2 clears close-on-exec on the copy, except when
+      // the descriptor already is 3; then it is cleared by hand.
+      ::dup2(output[1], STDOUT_FILENO);
+      ::dup2(output[1], STDERR_FILENO);
+      if (fd3 == Fd3::kClosed) {
+        ::close(3);
+      } else if (ready[1] == 3) {
+        ::fcntl(3, F_SETFD, 0);
+      } else {
+        ::dup2(ready[1], 3);
+      }
+      ::execv(argv[0], argv.data());
+      _exit(127);
+    }
+    ::close(output[1]);
+    ::close(ready[1]);  // sim_rfb holds the only write end: its close is the pipe's end
+    output_fd_ = output[0];
+    if (fd3 == Fd3::kPipe) {
+      ready_fd_ = ready[0];
+    } else {
+      ::close(ready[0]);
+    }
+  }
+  ~ManagedSim() {
+    if (!reaped_) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+    ::close(output_fd_);
+    if (ready_fd_ >= 0) ::close(ready_fd_);
+  }
+  ManagedSim(const ManagedSim&) = delete;
+  ManagedSim& operator=(const ManagedSim&) = delete;
+
+  /// Everything on the ready pipe up to its end (sim_rfb closes it after its line); "" without a pipe.
+  std::string ready_pipe(std::chrono::milliseconds timeout = 30s) {
+    std::string text;
+    if (ready_fd_ >= 0) CHECK(read_to_end(ready_fd_, text, timeout));
+    return text;
+  }
+  /// Reads stdout and stderr until `pattern` matches them; false on exit or timeout.
+  bool await_output(const std::regex& pattern, std::smatch& match, std::chrono::milliseconds timeout = 30s) {
+    const auto found = [&](const std::string& text) { return std::regex_search(text, match, pattern); };
+    return read_until(output_fd_, output_, found, timeout) == ReadOutcome::kDone;
+  }
+  /// Sends `signal` (0: none), reads the output to its end and reaps; the wait status, or -1 when
+  /// sim_rfb did not exit within `timeout`.
+  int exit_status(int signal, std::chrono::milliseconds timeout = 30s) {
+    if (signal != 0) ::kill(pid_, signal);
+    if (!read_to_end(output_fd_, output_, timeout)) return -1;
+    int status = 0;
+    ::waitpid(pid_, &status, 0);
+    reaped_ = true;
+    return status;
+  }
+  [[nodiscard]] const std::string& output() const { return output_; }
+
+ private:
+  pid_t pid_ = -1;
+  int output_fd_ = -1;
+  int ready_fd_ = -1;
+  std::string output_;
+  bool reaped_ = false;
+};
 
 }  // namespace
 
@@ -149,4 +268,69 @@ TEST_CASE("bad command lines and setup failures exit with a clear message") {
   const auto help = rfbsim::test::run_to_exit(rfbsim::test::sim_rfb_path(), {"--help"});
   CHECK(WEXITSTATUS(help.status) == 0);
   CHECK_THAT(help.output, Catch::Contains("usage: sim_rfb"));
+}
+
+TEST_CASE("sim_rfb --rfb-only --ready-fd 3 reports the port on the pipe and serves RFB, not HTTP") {
+  std::vector<std::string> args = kSmall;
+  args.insert(args.end(), {"--rfb-only", "--ready-fd", "3"});
+  ManagedSim sim(args, Fd3::kPipe);
+
+  // Exactly one line, then the end of the pipe: sim_rfb closed it.
+  const std::string ready = sim.ready_pipe();
+  std::smatch ready_match;
+  REQUIRE(std::regex_match(ready, ready_match, std::regex("ready ([0-9]+)\n")));
+  const int port = std::stoi(ready_match[1]);
+  CHECK(port > 0);
+  // The stdout line is still printed, naming the same port; without a page it is an RFB address.
+  std::smatch stdout_match;
+  REQUIRE(sim.await_output(std::regex(R"(sim_rfb ready: vnc://127\.0\.0\.1:([0-9]+)\n)"), stdout_match));
+  CHECK(std::stoi(stdout_match[1]) == port);
+
+  {
+    RfbTestClient client("127.0.0.1", port);
+    CHECK(client.width() == 320);
+    CHECK(client.wait_for_updates(1, 10s));
+  }
+
+  // No page and no status: a plain GET is dropped like a bad RFB client, and RFB is served on.
+  const std::string response = http_get(port, "/status.json");
+  CHECK(response.find("HTTP/1.1 200") == std::string::npos);
+  CHECK(response.find("\"tick\"") == std::string::npos);
+  RfbTestClient again("127.0.0.1", port);
+  CHECK(again.wait_for_updates(1, 10s));
+
+  const int exit_status = sim.exit_status(SIGTERM);
+  REQUIRE(exit_status != -1);
+  CHECK(WIFEXITED(exit_status));
+  CHECK(WEXITSTATUS(exit_status) == 0);
+}
+
+TEST_CASE("a ready fd that cannot be written ends sim_rfb with 1 and says why") {
+  const std::vector<std::string> args = {"--port", "0", "--width", "320", "--height", "240", "--rfb-only",
+                                         "--ready-fd", "3"};
+  SECTION("descriptor 3 is not open") {
+    ManagedSim sim(args, Fd3::kClosed);
+    const int exit_status = sim.exit_status(0);
+    REQUIRE(exit_status != -1);
+    CHECK(WIFEXITED(exit_status));
+    CHECK(WEXITSTATUS(exit_status) == 1);
+    CHECK_THAT(sim.output(), Catch::Contains("--ready-fd 3: not an open file descriptor"));
+    CHECK_THAT(sim.output(), !Catch::Contains("sim_rfb ready"));
+  }
+  SECTION("the pipe's reader is gone: EPIPE, not a silent SIGPIPE") {
+    ManagedSim sim(args, Fd3::kReaderGone);
+    const int exit_status = sim.exit_status(0);
+    REQUIRE(exit_status != -1);
+    CHECK_FALSE(WIFSIGNALED(exit_status));
+    CHECK(WIFEXITED(exit_status));
+    CHECK(WEXITSTATUS(exit_status) == 1);
+    CHECK_THAT(sim.output(), Catch::Contains("--ready-fd 3: cannot write the ready line (Broken pipe)"));
+    CHECK_THAT(sim.output(), !Catch::Contains("sim_rfb ready"));
+  }
+  SECTION("0, 1 and 2 are refused as bad arguments") {
+    const auto stderr_fd = rfbsim::test::run_to_exit(rfbsim::test::sim_rfb_path(), {"--ready-fd", "2"});
+    CHECK(WIFEXITED(stderr_fd.status));
+    CHECK(WEXITSTATUS(stderr_fd.status) == 2);
+    CHECK_THAT(stderr_fd.output, Catch::Contains("bad value '2' for --ready-fd"));
+  }
 }

@@ -64,3 +64,36 @@ TEST_CASE("the debug overlay flag is off by default, takes no value, and is in t
   CHECK(parse_sim_options({"--debug-overlay=1"}).error == "unknown argument '--debug-overlay=1'");
   CHECK(rfbsim::sim::sim_usage().find("--debug-overlay") != std::string::npos);
 }
+
+TEST_CASE("the ready fd option takes a descriptor of 3 or above") {
+  CHECK_FALSE(parse_sim_options({}).options.ready_fd);
+  const auto o = parse_sim_options({"--ready-fd", "3", "--port", "0"});
+  REQUIRE(o.error.empty());
+  CHECK(o.options.ready_fd == 3);
+  CHECK(o.options.port == 0);
+  CHECK(parse_sim_options({"--ready-fd", "1023"}).options.ready_fd == 1023);
+  // stdin, stdout and stderr are refused: the ready line belongs on a pipe of its own.
+  for (const char* fd : {"0", "1", "2"}) {
+    CHECK(parse_sim_options({"--ready-fd", fd}).error == std::string("bad value '") + fd + "' for --ready-fd");
+  }
+  CHECK(parse_sim_options({"--ready-fd", "-3"}).error == "bad value '-3' for --ready-fd");
+  CHECK(parse_sim_options({"--ready-fd", "three"}).error == "bad value 'three' for --ready-fd");
+  CHECK(parse_sim_options({"--ready-fd", "3x"}).error == "bad value '3x' for --ready-fd");
+  CHECK(parse_sim_options({"--ready-fd", ""}).error == "bad value '' for --ready-fd");
+  CHECK(parse_sim_options({"--ready-fd", "99999999999"}).error == "bad value '99999999999' for --ready-fd");
+  CHECK(parse_sim_options({"--ready-fd"}).error == "--ready-fd needs a value");
+  CHECK(rfbsim::sim::sim_usage().find("--ready-fd N") != std::string::npos);
+}
+
+TEST_CASE("the rfb-only flag takes no value and excludes --web-root") {
+  CHECK_FALSE(parse_sim_options({}).options.rfb_only);
+  const auto o = parse_sim_options({"--rfb-only", "--port", "0"});
+  REQUIRE(o.error.empty());
+  CHECK(o.options.rfb_only);
+  CHECK(o.options.port == 0);  // the flag takes no value: the next option is still read
+  CHECK(parse_sim_options({"--port", "0", "--rfb-only"}).options.rfb_only);
+  CHECK(parse_sim_options({"--rfb-only=1"}).error == "unknown argument '--rfb-only=1'");
+  CHECK(parse_sim_options({"--rfb-only", "--web-root", "/tmp/w"}).error == "--rfb-only serves no page; drop --web-root");
+  CHECK(parse_sim_options({"--web-root", "/tmp/w", "--rfb-only"}).error == "--rfb-only serves no page; drop --web-root");
+  CHECK(rfbsim::sim::sim_usage().find("--rfb-only") != std::string::npos);
+}

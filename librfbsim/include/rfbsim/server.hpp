@@ -58,7 +58,11 @@ struct ServerOptions {
   int max_clients = 4;                       ///< further RFB clients are refused
   bool view_only = false;                    ///< ignore every key and pointer event
   std::string desktop_name = "rfbsim";       ///< the name RFB clients show
-  std::string web_root;                      ///< directory served to plain HTTP GETs; empty = none
+  /// Directory served to plain HTTP GETs; empty = none. With neither a web root nor json_routes the port
+  /// speaks RFB only: each new connection goes straight to libvncserver (raw RFB, or RFB over WebSocket,
+  /// which it detects itself), without the up to 500 ms wait that tells a silent raw RFB client from a
+  /// browser about to send an HTTP request; a plain HTTP request is then closed as a bad RFB client.
+  std::string web_root;
   /// A client that takes longer than this to send one whole message (input, update request, handshake
   /// step) is dropped: the one network thread waits for it meanwhile.
   std::chrono::milliseconds read_timeout{1000};
@@ -68,11 +72,12 @@ struct ServerOptions {
   std::function<void(const ClientInfo&)> on_connect;     ///< network thread; may be empty
   std::function<void(const ClientInfo&)> on_disconnect;  ///< network thread; may be empty
   /// Extra JSON endpoints on the same port, e.g. {"/status.json", fn}; fn runs on an HTTP worker thread
-  /// and returns the body. Paths must start with '/'.
+  /// and returns the body. Paths must start with '/'. Empty, and with no web_root: RFB only (see web_root).
   std::map<std::string, std::function<std::string()>> json_routes;
 };
 
-/// Serves frames over RFB (raw TCP) and RFB-over-WebSocket on one port, plus an optional static web root.
+/// Serves frames over RFB (raw TCP) and RFB-over-WebSocket on one port, plus optional static files and
+/// JSON routes over plain HTTP.
 class Server {
  public:
   /// Binds, listens and starts the network thread. Throws std::runtime_error naming the cause

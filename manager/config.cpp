@@ -1,0 +1,386 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// sim_manager's settings: one table of keys serves the YAML file and the command line alike.
+#include "config.hpp"
+
+#include <arpa/inet.h>
+#include <yaml-cpp/yaml.h>
+
+#include <charconv>
+#include <cmath>
+#include <functional>
+#include <map>
+
+#include "start_request.hpp"
+
+namespace rfbsim::manager {
+
+namespace {
+
+// Applies a setting's values (one for a scalar, any number for a list); returns "" or what is wrong.
+using Apply = std::function<std::string(ManagerConfig&, const std::vector<std::string>&)>;
+
+struct Setting {
+  bool list = false;  // YAML sequence / comma-separated flag value
+  Apply apply;
+};
+
+template <typename T>
+bool parse_integer(const std::string& text, T low, T high, T& out) {
+  T value{};
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end || value < low || value > high) return false;
+  out = value;
+  return true;
+}
+
+Apply integer(int ManagerConfig::*field, int low, int high) {
+  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+    if (!parse_integer(v.front(), low, high, c.*field)) {
+      return "expected an integer " + std::to_string(low) + ".." + std::to_string(high);
+    }
+    return "";
+  };
+}
+
+Apply seconds(std::chrono::seconds ManagerConfig::*field, long long low) {
+  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+    long long value = 0;
+    if (!parse_integer(v.front(), low, 7LL * 24 * 3600, value)) {
+      return "expected whole seconds " + std::to_string(low) + ".." + std::to_string(7 * 24 * 3600);
+    }
+    c.*field = std::chrono::seconds(value);
+    return "";
+  };
+}
+
+Apply text(std::string ManagerConfig::*field, std::size_t min_length = 1) {
+  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+    if (v.front().size() < min_length) {
+      return min_length <= 1 ? "must not be empty" : "must be at least " + std::to_string(min_length) + " characters";
+    }
+    c.*field = v.front();
+    return "";
+  };
+}
+
+Apply boolean(bool ManagerConfig::*field) {
+  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+    if (v.front() == "true" || v.front() == "yes" || v.front() == "1") {
+      c.*field = true;
+    } else if (v.front() == "false" || v.front() == "no" || v.front() == "0") {
+      c.*field = false;
+    } else {
+      return "expected true or false";
+    }
+    return "";
+  };
+}
+
+// An origin as browsers send it: scheme://host[:port], nothing after.
+bool is_origin(const std::string& origin) {
+  std::string_view rest(origin);
+  if (rest.rfind("https://", 0) == 0) {
+    rest.remove_prefix(8);
+  } else if (rest.rfind("http://", 0) == 0) {
+    rest.remove_prefix(7);
+  } else {
+    return false;
+  }
+  if (rest.empty()) return false;
+  for (const char ch : rest) {
+    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '.' || ch == '-' || ch == ':' ||
+                    ch == '[' || ch == ']';
+    if (!ok) return false;  // upper case, paths, queries, user info: not an origin as browsers send it
+  }
+  return true;
+}
+
+const std::map<std::string, Setting>& settings() {
+  static const std::map<std::string, Setting> table = {
+      {"listen_address", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         in_addr address{};
+         if (::inet_pton(AF_INET, v.front().c_str(), &address) != 1) return "expected a numeric IPv4 address";
+         c.listen_address = v.front();
+         return "";
+       }}},
+      {"port", {false, integer(&ManagerConfig::port, 0, 65535)}},
+      {"tls_certificate", {false, text(&ManagerConfig::tls_certificate)}},
+      {"tls_private_key", {false, text(&ManagerConfig::tls_private_key)}},
+      {"session_command", {false, text(&ManagerConfig::session_command)}},
+      {"session_kind", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.front() == "sim_rfb") {
+           c.session_kind = SessionKind::kSimRfb;
+         } else if (v.front() == "rfb") {
+           c.session_kind = SessionKind::kRfb;
+         } else {
+           return "expected sim_rfb or rfb";
+         }
+         return "";
+       }}},
+      {"session_args", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         c.session_args = v;
+         return "";
+       }}},
+      {"max_sessions", {false, integer(&ManagerConfig::max_sessions, 1, 10000)}},
+      {"max_duration_s", {false, seconds(&ManagerConfig::max_duration, 1)}},
+      {"idle_timeout_s", {false, seconds(&ManagerConfig::idle_timeout, 1)}},
+      {"start_timeout_s", {false, seconds(&ManagerConfig::start_timeout, 1)}},
+      {"stop_grace_s", {false, seconds(&ManagerConfig::stop_grace, 0)}},
+      {"data_dir", {false, text(&ManagerConfig::data_dir)}},
+      {"scenarios", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.empty()) return "list at least one scenario";
+         for (const std::string& entry : v) {
+           const std::string name = entry.substr(0, entry.find('='));
+           if (!is_identifier(name)) {
+             return "'" + entry + "' is not a scenario name (letters, digits, - and _, at most 64), optionally =FILE";
+           }
+         }
+         c.scenarios = v;
+         return "";
+       }}},
+      {"frame_origins", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         for (const std::string& origin : v) {
+           if (!is_origin(origin)) {
+             return "'" + origin + "' is not an origin such as https://survey.example.org (lower case, no path)";
+           }
+         }
+         c.frame_origins = v;
+         return "";
+       }}},
+      {"admin_token", {false, text(&ManagerConfig::admin_token, 16)}},
+      {"link_secret", {false, text(&ManagerConfig::link_secret, 16)}},
+      {"allow_repeat", {false, boolean(&ManagerConfig::allow_repeat)}},
+      {"host_id", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (!is_identifier(v.front())) return "expected letters, digits, - and _ (at most 64)";
+         c.host_id = v.front();
+         return "";
+       }}},
+      {"web_root", {false, text(&ManagerConfig::web_root)}},
+      {"limit_address_space_mb", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (!parse_integer<std::uint64_t>(v.front(), 0, 1ULL << 30, c.limits.address_space_mb)) {
+           return "expected MiB, 0 = no limit";
+         }
+         return "";
+       }}},
+      {"limit_open_files", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (!parse_integer<std::uint64_t>(v.front(), 0, 1ULL << 20, c.limits.open_files)) {
+           return "expected a count, 0 = no limit";
+         }
+         return "";
+       }}},
+      {"limit_cpu_time_factor", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         double factor = 0;
+         const char* end = v.front().data() + v.front().size();
+         const auto [ptr, ec] = std::from_chars(v.front().data(), end, factor);
+         if (v.front().empty() || ec != std::errc() || ptr != end || !std::isfinite(factor) || factor < 0 ||
+             factor > 256) {
+           return "expected cores per session 0..256, 0 = no CPU limit";
+         }
+         c.limits.cpu_time_factor = factor;
+         return "";
+       }}},
+      {"limit_cpu_slack_s", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         long long value = 0;
+         if (!parse_integer(v.front(), 0LL, 86400LL, value)) return "expected whole seconds 0..86400";
+         c.limits.cpu_slack = std::chrono::seconds(value);
+         return "";
+       }}},
+  };
+  return table;
+}
+
+std::string flag_to_key(const std::string& flag) {
+  std::string key = flag.substr(2);
+  for (char& ch : key) {
+    if (ch == '-') ch = '_';
+  }
+  return key;
+}
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = text.find(',', start);
+    parts.push_back(text.substr(start, comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (parts.size() == 1 && parts.front().empty()) parts.clear();
+  return parts;
+}
+
+}  // namespace
+
+const char* session_kind_name(SessionKind kind) { return kind == SessionKind::kSimRfb ? "sim_rfb" : "rfb"; }
+
+std::string manager_usage() {
+  return "usage: sim_manager [--config FILE] [--listen-address ADDR] [--port N] [--tls-certificate PEM]\n"
+         "                   [--tls-private-key PEM] [--session-command PROGRAM] [--session-kind sim_rfb|rfb]\n"
+         "                   [--session-arg ARG]... [--max-sessions N] [--max-duration-s S] [--idle-timeout-s S]\n"
+         "                   [--data-dir DIR] [--scenarios A,B] [--frame-origins O1,O2] [--admin-token T]\n"
+         "                   [--link-secret S] [--allow-repeat true|false] [--host-id ID] [--web-root DIR]\n"
+         "       sim_manager [--config FILE] --sign 'uid=...&scenario=...'\n"
+         "Every flag is also a key of the YAML config file (--max-sessions N is max_sessions: N).\n"
+         "  --listen-address ADDR   numeric IPv4 address (default 127.0.0.1)\n"
+         "  --port N                the one public port (default 8080; 0 = any free port)\n"
+         "  --tls-certificate F, --tls-private-key F   serve HTTPS and WSS (OpenSSL)\n"
+         "  --session-command P     program started per session (default: sim_rfb)\n"
+         "  --session-kind K        sim_rfb (default), or rfb: any program that serves raw RFB on the port\n"
+         "                          given as {port} in its --session-arg list\n"
+         "  --session-arg A         one more argument for the session program (repeat as needed)\n"
+         "  --max-sessions N        live sessions at once (default 4)\n"
+         "  --max-duration-s S      a session ends S seconds after it started (default 300)\n"
+         "  --idle-timeout-s S      a session ends after S seconds with no browser connected (default 60)\n"
+         "  --start-timeout-s S     a session not ready after S seconds failed (default 30)\n"
+         "  --stop-grace-s S        seconds between SIGTERM and SIGKILL (default 5)\n"
+         "  --data-dir DIR          session index and session folders (default ./rfbsim-data)\n"
+         "  --scenarios A,B         scenarios a link may ask for; NAME or NAME=FILE (default warehouse,lab)\n"
+         "  --frame-origins O1,O2   origins allowed to frame the page, e.g. https://survey.example.org\n"
+         "  --admin-token T         enables /admin and /api/sessions (or RFBSIM_ADMIN_TOKEN; 16+ chars)\n"
+         "  --link-secret S         /start links must be signed (or RFBSIM_LINK_SECRET; 16+ chars)\n"
+         "  --allow-repeat B        a uid whose session ended may start another (default false)\n"
+         "  --host-id ID            this host's name in the index (default: the host name)\n"
+         "  --web-root DIR          the participant page (default: the built or installed one)\n"
+         "  --limit-address-space-mb N, --limit-open-files N, --limit-cpu-time-factor F, --limit-cpu-slack-s S\n"
+         "                          per-session resource limits (0 = none)\n"
+         "  --sign QUERY            print QUERY with its link signature (needs a link secret) and exit\n";
+}
+
+ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
+  ConfigOutcome outcome;
+  outcome.config = std::move(base);
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    outcome.error = path + ": cannot read the file";
+    return outcome;
+  } catch (const YAML::Exception& error) {
+    outcome.error = path + ":" + std::to_string(error.mark.line + 1) + ": " + error.msg;
+    return outcome;
+  }
+  if (root.IsNull()) return outcome;  // an empty file keeps every default
+  if (!root.IsMap()) {
+    outcome.error = path + ": expected a mapping of settings (key: value)";
+    return outcome;
+  }
+  for (const auto& item : root) {
+    const std::string key = item.first.as<std::string>();
+    const std::string where = path + ":" + std::to_string(item.first.Mark().line + 1) + ": " + key + ": ";
+    const auto setting = settings().find(key);
+    if (setting == settings().end()) {
+      outcome.error = where + "unknown setting";
+      return outcome;
+    }
+    std::vector<std::string> values;
+    const YAML::Node& node = item.second;
+    if (setting->second.list && node.IsSequence()) {
+      for (const auto& element : node) {
+        if (!element.IsScalar()) {
+          outcome.error = where + "expected a list of plain values";
+          return outcome;
+        }
+        values.push_back(element.Scalar());
+      }
+    } else if (node.IsScalar()) {
+      values.push_back(node.Scalar());
+      if (setting->second.list) values = split_commas(node.Scalar());
+    } else {
+      outcome.error = where + (setting->second.list ? "expected a list" : "expected a single value");
+      return outcome;
+    }
+    if (!setting->second.list && values.empty()) values.emplace_back();
+    const std::string problem = setting->second.apply(outcome.config, values);
+    if (!problem.empty()) {
+      outcome.error = where + problem;
+      return outcome;
+    }
+  }
+  return outcome;
+}
+
+ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
+                                 const std::vector<std::pair<std::string, std::string>>& environment) {
+  ConfigOutcome outcome;
+  // The config file first, wherever --config stands, so that flags always win over it.
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] != "--config") continue;
+    if (i + 1 >= args.size()) {
+      outcome.error = "--config needs a file";
+      return outcome;
+    }
+    outcome = load_config_file(args[i + 1], outcome.config);
+    if (!outcome.error.empty()) return outcome;
+  }
+  bool session_args_from_flags = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& flag = args[i];
+    if (flag == "--help" || flag == "-h") {
+      outcome.help = true;
+      return outcome;
+    }
+    if (flag.rfind("--", 0) != 0) {
+      outcome.error = "unexpected argument '" + flag + "'";
+      return outcome;
+    }
+    if (i + 1 >= args.size()) {
+      outcome.error = flag + " needs a value";
+      return outcome;
+    }
+    const std::string& value = args[++i];
+    if (flag == "--config") continue;
+    if (flag == "--sign") {
+      outcome.sign_query = value;
+      continue;
+    }
+    if (flag == "--session-arg") {
+      // Repeated: the flags' list replaces the file's as a whole.
+      if (!session_args_from_flags) outcome.config.session_args.clear();
+      session_args_from_flags = true;
+      outcome.config.session_args.push_back(value);
+      continue;
+    }
+    const auto setting = settings().find(flag_to_key(flag));
+    if (setting == settings().end() || flag_to_key(flag) == "session_args") {
+      outcome.error = "unknown option '" + flag + "'";
+      return outcome;
+    }
+    const std::vector<std::string> values =
+        setting->second.list ? split_commas(value) : std::vector<std::string>{value};
+    const std::string problem = setting->second.apply(outcome.config, values);
+    if (!problem.empty()) {
+      outcome.error = flag + " '" + value + "': " + problem;
+      return outcome;
+    }
+  }
+  // Secrets from the environment (e.g. a systemd EnvironmentFile) keep them out of `ps`.
+  for (const auto& [name, value] : environment) {
+    const char* key = name == "RFBSIM_ADMIN_TOKEN" ? "admin_token" : name == "RFBSIM_LINK_SECRET" ? "link_secret" : nullptr;
+    if (key == nullptr) continue;
+    std::string& field = name == "RFBSIM_ADMIN_TOKEN" ? outcome.config.admin_token : outcome.config.link_secret;
+    if (!field.empty()) continue;
+    const std::string problem = settings().at(key).apply(outcome.config, {value});
+    if (!problem.empty()) {
+      outcome.error = name + ": " + problem;
+      return outcome;
+    }
+  }
+  if (outcome.error.empty()) outcome.error = validate_config(outcome.config);
+  return outcome;
+}
+
+std::string validate_config(const ManagerConfig& config) {
+  if (config.tls_certificate.empty() != config.tls_private_key.empty()) {
+    return "TLS needs both tls_certificate and tls_private_key";
+  }
+  if (config.session_kind == SessionKind::kRfb) {
+    bool has_port = false;
+    for (const std::string& arg : config.session_args) has_port = has_port || arg.find("{port}") != std::string::npos;
+    if (!has_port) return "session_kind rfb needs {port} in session_args, where the program is told its port";
+  }
+  return "";
+}
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// sim_manager's settings: defaults, the YAML config file and the command line, validated without side
+// effects so that they can be unit-tested.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rfbsim::manager {
+
+/// How the manager talks to the program it starts for each session.
+enum class SessionKind {
+  kSimRfb,  ///< sim_rfb: the manager adds --port 0 --rfb-only --ready-fd 3 and the link's parameters
+  kRfb,     ///< any program serving raw RFB on a loopback port: args may use {port} {scenario} {seed} {uid}
+            ///< {data_dir}; ready once the port accepts a connection
+};
+
+/// Resource limits applied to every session process (0 = no limit).
+struct ProcessLimits {
+  std::uint64_t address_space_mb = 8192;  ///< RLIMIT_AS, MiB (llvmpipe reserves a lot of address space)
+  std::uint64_t open_files = 1024;        ///< RLIMIT_NOFILE
+  /// RLIMIT_CPU = max_duration x cpu_time_factor + cpu_slack: a session may use about this many cores on
+  /// average (renderer threads) and the slack covers start-up and the stop grace period.
+  double cpu_time_factor = 2.0;
+  std::chrono::seconds cpu_slack{60};
+};
+
+/// Everything sim_manager can be configured with; start from the defaults.
+struct ManagerConfig {
+  std::string listen_address = "127.0.0.1";  ///< numeric IPv4 address; loopback unless told otherwise
+  int port = 8080;                           ///< the one public port (HTTP/WS, or HTTPS/WSS with TLS)
+  std::string tls_certificate;               ///< PEM certificate chain; with tls_private_key enables TLS
+  std::string tls_private_key;               ///< PEM private key
+  std::string session_command = "sim_rfb";   ///< program path; "sim_rfb" = the one built or installed
+  SessionKind session_kind = SessionKind::kSimRfb;
+  std::vector<std::string> session_args;     ///< extra arguments (kRfb: the whole argument template)
+  int max_sessions = 4;                      ///< live sessions at once; the next participant is told to wait
+  std::chrono::seconds max_duration{300};    ///< a session is ended this long after it started (SEAN-EP: 5 min)
+  std::chrono::seconds idle_timeout{60};     ///< ended after this long with no browser connected
+  std::chrono::seconds start_timeout{30};    ///< a session not ready by then failed to start
+  std::chrono::seconds stop_grace{5};        ///< SIGTERM, then SIGKILL after this long
+  std::string data_dir = "rfbsim-data";      ///< session index (sessions.db) and one folder per session
+  std::vector<std::string> scenarios = {"warehouse", "lab"};  ///< allowed; the first is the default
+  std::vector<std::string> frame_origins;    ///< origins allowed to frame the page and open its WebSocket
+  std::string admin_token;                   ///< empty = /admin and /api are off
+  std::string link_secret;                   ///< non-empty = /start links must carry a valid sig
+  bool allow_repeat = false;                 ///< a uid whose session ended may start another
+  std::string host_id;                       ///< recorded in the index; empty = this machine's host name
+  std::string web_root;                      ///< participant page; empty = the built or installed one
+  ProcessLimits limits;
+};
+
+/// The outcome of reading settings: a config, or a message naming the file, line or flag at fault.
+struct ConfigOutcome {
+  ManagerConfig config;
+  std::string error;  ///< empty on success
+  bool help = false;  ///< --help was given
+  std::string sign_query;  ///< --sign QUERY was given: print the signed query and exit
+};
+
+/// Reads a YAML config file over `base`. Unknown keys and bad values are errors naming the key and line.
+ConfigOutcome load_config_file(const std::string& path, ManagerConfig base);
+
+/// Parses the command line (without the program name): --config FILE first, then flags over it, then
+/// RFBSIM_ADMIN_TOKEN and RFBSIM_LINK_SECRET from `environment` where the flags left them empty.
+ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
+                                 const std::vector<std::pair<std::string, std::string>>& environment = {});
+
+/// Checks a finished config for settings that cannot work together; "" when it is fine.
+std::string validate_config(const ManagerConfig& config);
+
+/// The --help text.
+std::string manager_usage();
+
+/// "sim_rfb" or "rfb".
+const char* session_kind_name(SessionKind kind);
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,516 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The public port on websocketpp: routes HTTP requests to their handlers and WebSockets to relays.
+// Compiled as C++17 (websocketpp 0.8.2 does not build as C++20 with g++ 12).
+#include "frontend.hpp"
+
+#include <boost/asio/ssl/context.hpp>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <websocketpp/config/asio.hpp>
+#include <websocketpp/server.hpp>
+
+#include "link_signature.hpp"
+#include "pages.hpp"
+#include "query.hpp"
+#include "relay.hpp"
+#include "routes.hpp"
+#include "start_request.hpp"
+#include "static_files.hpp"
+#include "web_policy.hpp"
+
+namespace rfbsim::manager {
+
+namespace {
+
+namespace asio = boost::asio;
+using websocketpp::connection_hdl;
+using CloseCode = websocketpp::close::status::value;
+
+// Longer request targets are refused (414) before any parsing: links are short.
+constexpr std::size_t kMaxTarget = 4096;
+// How long the busy page waits before it tries the link again.
+constexpr int kBusyRetrySeconds = 10;
+// How many ended sessions the admin API lists besides the live ones.
+constexpr int kAdminRecentSessions = 200;
+// After a session's socket closes, how long to wait for the process's exit to say why, before telling the
+// browser the connection was lost.
+constexpr auto kUpstreamLostGrace = std::chrono::milliseconds(300);
+
+// What a browser is told when its session closes, by the session's final (or coming) state.
+std::pair<CloseCode, std::string> close_for(SessionState state) {
+  namespace status = websocketpp::close::status;
+  switch (state) {
+    case SessionState::kFinished: return {status::normal, "session finished"};
+    case SessionState::kExpired: return {status::going_away, "session expired"};
+    case SessionState::kIdle: return {status::going_away, "session ended after being idle"};
+    case SessionState::kEnded: return {status::going_away, "session ended by the researcher"};
+    case SessionState::kShutdown: return {status::going_away, "server shutting down"};
+    case SessionState::kFailed: return {status::internal_endpoint_error, "the simulator could not start"};
+    default: return {status::internal_endpoint_error, "the simulator stopped unexpectedly"};
+  }
+}
+
+std::string read_file(const std::filesystem::path& path, bool& ok) {
+  std::ifstream in(path, std::ios::binary);
+  ok = static_cast<bool>(in) && std::filesystem::is_regular_file(path);
+  if (!ok) return "";
+  std::ostringstream content;
+  content << in.rdbuf();
+  return content.str();
+}
+
+std::string session_json(const Session& s, bool include_token) {
+  const auto time = [](const std::optional<WallTime>& t) { return t ? "\"" + iso_utc(*t) + "\"" : std::string("null"); };
+  std::string json = "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"scenario\":\"" +
+                     json_escape(s.scenario) + "\",\"seed\":\"" + std::to_string(s.seed) + "\",\"state\":\"" +
+                     state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"exit_status\":\"" +
+                     json_escape(s.exit_status) + "\",\"created_at\":\"" + iso_utc(s.created) +
+                     "\",\"ready_at\":" + time(s.ready_at) + ",\"ended_at\":" + time(s.ended_at) +
+                     ",\"data_path\":\"" + json_escape(s.data_path) + "\",\"params\":" +
+                     (s.params_json.empty() ? "{}" : s.params_json);
+  if (include_token) json += ",\"token\":\"" + s.token + "\"";
+  return json + "}";
+}
+
+template <typename WsConfig>
+class FrontendImpl final : public Frontend, public SessionListener {
+ public:
+  using Server = websocketpp::server<WsConfig>;
+  using ConnectionPtr = typename Server::connection_ptr;
+  using RelayT = Relay<Server>;
+
+  FrontendImpl(asio::io_context& io, const ManagerConfig& config, Supervisor& supervisor, Metrics& metrics,
+               std::string web_root, bool tls)
+      : io_(io), config_(config), supervisor_(supervisor), metrics_(metrics), web_root_(std::move(web_root)), tls_(tls) {
+    server_.clear_access_channels(websocketpp::log::alevel::all);
+    server_.clear_error_channels(websocketpp::log::elevel::all);
+    server_.init_asio(&io_);
+    server_.set_user_agent("rfbsim-manager");
+    server_.set_reuse_addr(true);
+    server_.set_listen_backlog(256);
+    server_.set_open_handshake_timeout(5000);   // a slow or silent client loses its connection, not ours
+    server_.set_close_handshake_timeout(2000);
+    server_.set_max_http_body_size(64 * 1024);
+    server_.set_max_message_size(RelayT::kMaxPending);
+    server_.set_http_handler([this](connection_hdl hdl) { handle_http(server_.get_con_from_hdl(hdl)); });
+    server_.set_validate_handler([this](connection_hdl hdl) { return validate_websocket(server_.get_con_from_hdl(hdl)); });
+    server_.set_open_handler([this](connection_hdl hdl) { open_websocket(hdl); });
+    server_.set_close_handler([this](connection_hdl hdl) { forget_websocket(hdl); });
+    server_.set_fail_handler([this](connection_hdl hdl) { forget_websocket(hdl); });
+    server_.set_message_handler([this](connection_hdl hdl, typename Server::message_ptr message) {
+      const auto it = relays_.find(hdl);
+      if (it != relays_.end()) it->second->from_browser(std::move(message->get_raw_payload()));
+    });
+    supervisor_.set_listener(this);
+  }
+
+  ~FrontendImpl() override { supervisor_.set_listener(nullptr); }
+
+  Server& server() { return server_; }
+
+  void listen() {
+    websocketpp::lib::error_code ec;
+    boost::system::error_code address_ec;
+    const auto address = asio::ip::make_address_v4(config_.listen_address, address_ec);
+    if (address_ec) throw std::runtime_error("bad listen address " + config_.listen_address);
+    server_.listen(asio::ip::tcp::endpoint(address, static_cast<unsigned short>(config_.port)), ec);
+    if (ec) {
+      throw std::runtime_error("cannot listen on " + config_.listen_address + ":" + std::to_string(config_.port) +
+                               ": " + ec.message());
+    }
+    server_.start_accept(ec);
+    if (ec) throw std::runtime_error("cannot accept connections: " + ec.message());
+  }
+
+  int port() const override {
+    boost::system::error_code ec;
+    const auto endpoint = const_cast<Server&>(server_).get_local_endpoint(ec);
+    return ec ? 0 : endpoint.port();
+  }
+  const char* scheme() const override { return tls_ ? "https" : "http"; }
+
+  void stop() override {
+    websocketpp::lib::error_code ec;
+    server_.stop_listening(ec);
+    auto relays = relays_;
+    for (auto& [hdl, relay] : relays) relay->close(websocketpp::close::status::going_away, "server shutting down");
+  }
+
+  // SessionListener
+  void session_ready(const Session& session) override {
+    for (auto& [hdl, relay] : relays_) {
+      if (relay->session_id() == session.id) relay->connect(session.port);
+    }
+  }
+
+  void session_closing(const Session& session) override {
+    const auto [code, reason] = close_for(session.state == SessionState::kEnding ? session.end_as : session.state);
+    auto relays = relays_;  // closing may call back into forget_websocket
+    for (auto& [hdl, relay] : relays) {
+      if (relay->session_id() == session.id) relay->close(code, reason);
+    }
+  }
+
+ private:
+  // ------------------------------------------------------------------------------------------------------
+  // HTTP
+  // ------------------------------------------------------------------------------------------------------
+  void respond(const ConnectionPtr& con, int status, const std::string& body, const std::string& content_type,
+               const Headers& extra = {}) {
+    con->set_status(static_cast<websocketpp::http::status_code::value>(status));
+    con->set_body(body);
+    con->replace_header("Content-Type", content_type);
+    con->replace_header("Cache-Control", "no-store");
+    for (const auto& [name, value] : extra) con->replace_header(name, value);
+  }
+
+  void respond_page(const ConnectionPtr& con, int status, const std::string& html, Headers extra = {}) {
+    Headers headers = page_headers(config_.frame_origins);
+    headers.insert(headers.end(), extra.begin(), extra.end());
+    respond(con, status, html, "text/html; charset=utf-8", headers);
+  }
+
+  void respond_json(const ConnectionPtr& con, int status, const std::string& json) {
+    respond(con, status, json, "application/json");
+  }
+
+  void refuse(const ConnectionPtr& con, int status, Rejection reason, const std::string& title,
+              const std::string& message) {
+    metrics_.count_rejection(reason);
+    respond_page(con, status, error_page(status, title, message));
+  }
+
+  void handle_http(const ConnectionPtr& con) {
+    const std::string& target = con->get_resource();
+    if (target.size() > kMaxTarget) {
+      refuse(con, 414, Rejection::kBadRequest, "Link too long", "The address is too long to be a study link.");
+      return;
+    }
+    const Route route = route_request(con->get_request().get_method(), target);
+    switch (route.kind) {
+      case RouteKind::kHome: respond_page(con, 200, home_page()); return;
+      case RouteKind::kStart: handle_start(con, route); return;
+      case RouteKind::kSessionFile: handle_session_file(con, route); return;
+      case RouteKind::kSessionStatus: handle_session_status(con, route); return;
+      case RouteKind::kSessionSocket:
+        refuse(con, 400, Rejection::kBadRequest, "WebSocket only", "This address takes WebSocket connections only.");
+        return;
+      case RouteKind::kHealth:
+        respond_json(con, 200, "{\"status\":\"ok\",\"live_sessions\":" + std::to_string(supervisor_.table().size()) +
+                                   ",\"capacity\":" + std::to_string(config_.max_sessions) + "}");
+        return;
+      case RouteKind::kMetrics:
+        respond(con, 200, metrics_.render(supervisor_.counts_by_state(), config_.max_sessions, static_cast<int>(relays_.size())),
+                "text/plain; version=0.0.4; charset=utf-8");
+        return;
+      case RouteKind::kAdminPage: handle_admin_page(con, route); return;
+      case RouteKind::kApiSessions: handle_api_sessions(con); return;
+      case RouteKind::kApiEndSession: handle_api_end(con, route); return;
+      case RouteKind::kBadMethod:
+        metrics_.count_rejection(Rejection::kBadRequest);
+        respond_page(con, 405, error_page(405, "Method not allowed", "This address does not take that method."),
+                     {{"Allow", route.kind == RouteKind::kApiEndSession ? "POST" : "GET, HEAD"}});
+        return;
+      case RouteKind::kNotFound:
+        break;
+    }
+    refuse(con, 404, Rejection::kBadRequest, "Not found", "There is nothing at this address.");
+  }
+
+  void handle_start(const ConnectionPtr& con, const Route& route) {
+    std::string error;
+    const auto params = parse_query(route.query, error);
+    if (!params) {
+      refuse(con, 400, Rejection::kBadRequest, "This link is not valid", error);
+      return;
+    }
+    // The signature before anything else, so that unsigned links learn nothing about valid parameters.
+    if (!config_.link_secret.empty() && !link_signature_valid(*params, config_.link_secret)) {
+      refuse(con, 403, Rejection::kBadSignature, "This link is not valid",
+             "The link's signature is missing or wrong. Please use the exact link your survey gave you.");
+      return;
+    }
+    const StartParse parsed = parse_start_request(*params, scenario_names(config_.scenarios));
+    if (!parsed.request) {
+      refuse(con, 400, Rejection::kBadRequest, "This link is not valid", parsed.error);
+      return;
+    }
+    const StartOutcome outcome = supervisor_.start(*parsed.request);
+    switch (outcome.kind) {
+      case StartOutcome::Kind::kJoined:
+      case StartOutcome::Kind::kStarted: {
+        const std::string location = "/s/" + outcome.token + "/";
+        respond_page(con, 302, "<!DOCTYPE html><title>Starting</title><a href=\"" + location + "\">Continue</a>\n",
+                     {{"Location", location}});
+        return;
+      }
+      case StartOutcome::Kind::kBusy:
+        metrics_.count_rejection(Rejection::kBusy);
+        respond_page(con, 503, busy_page(kBusyRetrySeconds), {{"Retry-After", std::to_string(kBusyRetrySeconds)}});
+        return;
+      case StartOutcome::Kind::kCompleted:
+        metrics_.count_rejection(Rejection::kCompleted);
+        respond_page(con, 409, completed_page());
+        return;
+      case StartOutcome::Kind::kFailed:
+        respond_page(con, 503, error_page(503, "The simulation could not start",
+                                          "Something went wrong on our side. Please try the link again in a "
+                                          "minute, or tell the researcher."));
+        return;
+    }
+  }
+
+  void handle_session_file(const ConnectionPtr& con, const Route& route) {
+    const auto session = supervisor_.find(route.token);
+    if (!session) {
+      refuse(con, 404, Rejection::kUnknownSession, "Session not found",
+             "This session link is not valid. Please use the link your survey gave you.");
+      return;
+    }
+    if (!is_live(session->state) || session->state == SessionState::kEnding) {
+      metrics_.count_rejection(Rejection::kEndedSession);
+      respond_page(con, 410, session_ended_page(state_name(session->state == SessionState::kEnding ? session->end_as
+                                                                                                 : session->state)));
+      return;
+    }
+    const auto path = detail::resolve_static_path(web_root_, "/" + route.file);
+    bool ok = false;
+    const std::string body = path ? read_file(*path, ok) : "";
+    if (!ok) {
+      refuse(con, 404, Rejection::kBadRequest, "Not found", "There is nothing at this address.");
+      return;
+    }
+    Headers headers = page_headers(config_.frame_origins);
+    respond(con, 200, body, std::string(detail::mime_type_for(*path)), headers);
+  }
+
+  void handle_session_status(const ConnectionPtr& con, const Route& route) {
+    const auto session = supervisor_.find(route.token);
+    if (!session) {
+      metrics_.count_rejection(Rejection::kUnknownSession);
+      respond_json(con, 404, "{\"error\":\"unknown session\"}");
+      return;
+    }
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::system_clock::now() - session->created).count();
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, "%.3f", elapsed);
+    const SessionState shown = session->state == SessionState::kEnding ? session->end_as : session->state;
+    respond_json(con, 200, std::string("{\"state\":\"") + state_name(session->state) + "\",\"ends_as\":\"" +
+                               state_name(shown) + "\",\"elapsed_s\":" + seconds + "}");
+  }
+
+  bool admin_allowed(const ConnectionPtr& con) {
+    if (config_.admin_token.empty()) {
+      refuse(con, 404, Rejection::kUnauthorized, "Not found", "Administration is not enabled on this server.");
+      return false;
+    }
+    if (!admin_authorized(con->get_request_header("Authorization"), config_.admin_token)) {
+      metrics_.count_rejection(Rejection::kUnauthorized);
+      respond_page(con, 401, error_page(401, "Administrator token needed", "Log in with the admin token as password."),
+                   {{"WWW-Authenticate", "Basic realm=\"rfbsim admin\", charset=\"UTF-8\""}});
+      return false;
+    }
+    return true;
+  }
+
+  void handle_admin_page(const ConnectionPtr& con, const Route& route) {
+    if (!admin_allowed(con)) return;
+    // Only the admin page's own files: /admin is admin.html, /admin/admin.js its script.
+    const std::string file = route.file.empty() ? "admin.html" : route.file;
+    if (file != "admin.html" && file != "admin.js") {
+      refuse(con, 404, Rejection::kBadRequest, "Not found", "There is nothing at this address.");
+      return;
+    }
+    const std::filesystem::path path = std::filesystem::path(web_root_) / file;
+    bool ok = false;
+    const std::string body = read_file(path, ok);
+    if (!ok) {
+      refuse(con, 404, Rejection::kBadRequest, "Not found", "The admin page is not installed.");
+      return;
+    }
+    Headers headers = page_headers({});  // the admin page is never framed by a survey
+    respond(con, 200, body, std::string(detail::mime_type_for(path)), headers);
+  }
+
+  void handle_api_sessions(const ConnectionPtr& con) {
+    if (!admin_allowed(con)) return;
+    std::string json = "{\"capacity\":" + std::to_string(config_.max_sessions) + ",\"live\":[";
+    bool first = true;
+    for (Session* session : supervisor_.table().all()) {
+      json += (first ? "" : ",") + session_json(*session, true);
+      first = false;
+    }
+    json += "],\"recent\":[";
+    first = true;
+    try {
+      for (const Session& session : supervisor_.recent(kAdminRecentSessions)) {
+        if (is_live(session.state)) continue;
+        json += (first ? "" : ",") + session_json(session, false);
+        first = false;
+      }
+    } catch (const std::exception& error) {
+      respond_json(con, 500, "{\"error\":\"" + json_escape(error.what()) + "\"}");
+      return;
+    }
+    respond_json(con, 200, json + "]}");
+  }
+
+  void handle_api_end(const ConnectionPtr& con, const Route& route) {
+    if (!admin_allowed(con)) return;
+    // A custom header cannot be sent cross-site without a CORS preflight (which we never grant): a page
+    // elsewhere cannot make a logged-in browser end sessions.
+    if (con->get_request_header("X-Rfbsim-Admin").empty()) {
+      metrics_.count_rejection(Rejection::kUnauthorized);
+      respond_json(con, 403, "{\"error\":\"send the X-Rfbsim-Admin header\"}");
+      return;
+    }
+    if (!supervisor_.end_by_admin(route.session_id)) {
+      respond_json(con, 404, "{\"error\":\"no live session " + std::to_string(route.session_id) + "\"}");
+      return;
+    }
+    respond_json(con, 200, "{\"ending\":" + std::to_string(route.session_id) + "}");
+  }
+
+  // ------------------------------------------------------------------------------------------------------
+  // WebSocket
+  // ------------------------------------------------------------------------------------------------------
+  bool reject_websocket(const ConnectionPtr& con, int status, Rejection reason, const std::string& message) {
+    metrics_.count_rejection(reason);
+    con->set_status(static_cast<websocketpp::http::status_code::value>(status));
+    con->set_body(message + "\n");
+    con->replace_header("Content-Type", "text/plain; charset=utf-8");
+    return false;
+  }
+
+  bool validate_websocket(const ConnectionPtr& con) {
+    const std::string& target = con->get_resource();
+    if (target.size() > kMaxTarget) return reject_websocket(con, 414, Rejection::kBadRequest, "address too long");
+    const Route route = route_request(con->get_request().get_method(), target);
+    if (route.kind != RouteKind::kSessionSocket) {
+      return reject_websocket(con, 404, Rejection::kBadRequest, "no WebSocket at this address");
+    }
+    if (!websocket_origin_allowed(con->get_request_header("Origin"), con->get_request_header("Host"),
+                                  config_.frame_origins)) {
+      return reject_websocket(con, 403, Rejection::kForbiddenOrigin, "this origin may not connect");
+    }
+    Session* session = supervisor_.table().by_token(route.token);
+    if (session == nullptr) {
+      const auto ended = supervisor_.find(route.token);
+      if (ended) return reject_websocket(con, 410, Rejection::kEndedSession, "this session has ended");
+      return reject_websocket(con, 404, Rejection::kUnknownSession, "no such session");
+    }
+    if (session->state == SessionState::kEnding) {
+      return reject_websocket(con, 410, Rejection::kEndedSession, "this session has ended");
+    }
+    // noVNC offers "binary" when it opens the socket itself; our page offers nothing.
+    for (const std::string& offered : con->get_requested_subprotocols()) {
+      if (offered == "binary") {
+        con->select_subprotocol(offered);
+        break;
+      }
+    }
+    pending_tokens_[con->get_handle()] = route.token;
+    return true;
+  }
+
+  void open_websocket(connection_hdl hdl) {
+    const auto token = pending_tokens_.find(hdl);
+    if (token == pending_tokens_.end()) return;
+    const std::string session_token = token->second;
+    pending_tokens_.erase(token);
+    auto con = server_.get_con_from_hdl(hdl);
+    Session* session = supervisor_.table().by_token(session_token);
+    if (session == nullptr || session->state == SessionState::kEnding) {
+      const auto [code, reason] = close_for(session ? session->end_as : SessionState::kCrashed);
+      websocketpp::lib::error_code ec;
+      con->close(code, reason, ec);
+      return;
+    }
+    auto relay = std::make_shared<RelayT>(server_, hdl, session->id, session->token, metrics_,
+                                          [this](RelayT& lost) { upstream_lost(lost); });
+    relays_[hdl] = relay;
+    metrics_.count_relay_open();
+    supervisor_.client_connected(session->id);
+    if (session->state == SessionState::kRunning) relay->connect(session->port);
+  }
+
+  void forget_websocket(connection_hdl hdl) {
+    pending_tokens_.erase(hdl);
+    const auto it = relays_.find(hdl);
+    if (it == relays_.end()) return;
+    const auto relay = it->second;
+    relays_.erase(it);
+    relay->browser_gone();
+    supervisor_.client_disconnected(relay->session_id());
+  }
+
+  // The session's socket closed under a relay. Usually the process is ending or gone, and its exit will
+  // say why; give that a moment to arrive, then tell the browser what happened.
+  void upstream_lost(RelayT& relay) {
+    auto timer = std::make_shared<asio::steady_timer>(io_, kUpstreamLostGrace);
+    timer->async_wait([this, timer, weak = std::weak_ptr<RelayT>(relay.shared_from_this())](
+                          const boost::system::error_code&) {
+      const auto alive = weak.lock();
+      if (!alive) return;
+      const auto session = supervisor_.find(alive->token());
+      if (session && session->state != SessionState::kRunning) {
+        const auto [code, reason] =
+            close_for(session->state == SessionState::kEnding ? session->end_as : session->state);
+        alive->close(code, reason);
+      } else {
+        alive->close(websocketpp::close::status::internal_endpoint_error, "lost the connection to the simulator");
+      }
+    });
+  }
+
+  asio::io_context& io_;
+  const ManagerConfig& config_;
+  Supervisor& supervisor_;
+  Metrics& metrics_;
+  std::string web_root_;
+  bool tls_;
+  Server server_;
+  std::map<connection_hdl, std::shared_ptr<RelayT>, std::owner_less<connection_hdl>> relays_;
+  std::map<connection_hdl, std::string, std::owner_less<connection_hdl>> pending_tokens_;  // validated, not open
+};
+
+// TLS settings for the public port: TLS 1.2 and later, the certificate chain and key loaded once, now,
+// so that a bad file stops the manager at start-up rather than at the first participant.
+std::shared_ptr<asio::ssl::context> make_tls_context(const ManagerConfig& config) {
+  auto context = std::make_shared<asio::ssl::context>(asio::ssl::context::tls_server);
+  context->set_options(asio::ssl::context::default_workarounds | asio::ssl::context::no_sslv2 |
+                       asio::ssl::context::no_sslv3 | asio::ssl::context::no_tlsv1 |
+                       asio::ssl::context::no_tlsv1_1 | asio::ssl::context::single_dh_use);
+  boost::system::error_code ec;
+  context->use_certificate_chain_file(config.tls_certificate, ec);
+  if (ec) throw std::runtime_error("cannot load the TLS certificate " + config.tls_certificate + ": " + ec.message());
+  context->use_private_key_file(config.tls_private_key, asio::ssl::context::pem, ec);
+  if (ec) throw std::runtime_error("cannot load the TLS private key " + config.tls_private_key + ": " + ec.message());
+  if (SSL_CTX_check_private_key(context->native_handle()) != 1) {
+    throw std::runtime_error("the TLS private key " + config.tls_private_key + " does not match the certificate");
+  }
+  return context;
+}
+
+}  // namespace
+
+std::unique_ptr<Frontend> make_frontend(asio::io_context& io, const ManagerConfig& config, Supervisor& supervisor,
+                                        Metrics& metrics, const std::string& web_root) {
+  if (config.tls_certificate.empty()) {
+    auto frontend = std::make_unique<FrontendImpl<websocketpp::config::asio>>(io, config, supervisor, metrics,
+                                                                              web_root, false);
+    frontend->listen();
+    return frontend;
+  }
+  auto context = make_tls_context(config);
+  auto frontend = std::make_unique<FrontendImpl<websocketpp::config::asio_tls>>(io, config, supervisor, metrics,
+                                                                                web_root, true);
+  frontend->server().set_tls_init_handler([context](connection_hdl) { return context; });
+  frontend->listen();
+  return frontend;
+}
+
+}  // namespace rfbsim::manager

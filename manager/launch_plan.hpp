@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The command line a session is started with, from the config and the participant's link. Pure: the
+// arguments are a list (never a shell string), and every value in them was validated before.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+#include "start_request.hpp"
+
+namespace rfbsim::manager {
+
+/// Where and with what a session runs.
+struct LaunchContext {
+  std::uint64_t seed = 0;   ///< the link's seed or a drawn one
+  int port = 0;             ///< kRfb: the port picked for the program; kSimRfb: 0 (it picks and reports)
+  std::string data_dir;     ///< the session's folder
+};
+
+/// Arguments after the program name.
+///  - kSimRfb: --port 0 --bind 127.0.0.1 --rfb-only --ready-fd 3 --scenario S --seed N, one flag per
+///    override, then config.session_args.
+///  - kRfb: config.session_args with {port}, {scenario}, {seed}, {uid} and {data_dir} replaced.
+std::vector<std::string> session_arguments(const ManagerConfig& config, const StartRequest& request,
+                                           const LaunchContext& context);
+
+/// The link's parameters (as validated: uid, scenario, seed, overrides) as a JSON object for the index.
+std::string parameters_json(const StartRequest& request, std::uint64_t seed);
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,163 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// sim_manager: one public port, one link per participant, one session process per participant.
+//
+// Everything runs on one asio I/O thread (the main thread): HTTP and WebSocket through websocketpp, the
+// relays, the session processes' readiness pipes, their timers and SIGCHLD. SQLite is written from the
+// same thread, so no state is shared between threads.
+#include <unistd.h>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+
+#include "config.hpp"
+#include "frontend.hpp"
+#include "link_signature.hpp"
+#include "metrics.hpp"
+#include "session_index.hpp"
+#include "start_request.hpp"
+#include "supervisor.hpp"
+
+extern char** environ;
+
+namespace {
+
+using rfbsim::manager::ManagerConfig;
+
+std::vector<std::pair<std::string, std::string>> environment_variables() {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (char** entry = environ; *entry != nullptr; ++entry) {
+    const std::string text(*entry);
+    const std::size_t eq = text.find('=');
+    if (eq != std::string::npos) out.emplace_back(text.substr(0, eq), text.substr(eq + 1));
+  }
+  return out;
+}
+
+// This machine's name as an identifier (letters, digits, - and _), for the index's host_id column.
+std::string default_host_id() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0 || name[0] == '\0') return "localhost";
+  std::string id;
+  for (const char* p = name; *p != '\0' && id.size() < 64; ++p) {
+    const char ch = *p;
+    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_';
+    id.push_back(ok ? ch : '-');
+  }
+  return id;
+}
+
+bool is_executable(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec) && ::access(path.c_str(), X_OK) == 0;
+}
+
+// "sim_rfb" means the one built beside this binary, else the installed one; anything else is a path.
+std::string resolve_program(const std::string& command) {
+  if (command == "sim_rfb") {
+    for (const char* candidate : {RFBSIM_BUILD_SIM_RFB, RFBSIM_INSTALLED_SIM_RFB}) {
+      if (is_executable(candidate)) return candidate;
+    }
+    throw std::runtime_error(std::string("sim_rfb not found (looked for ") + RFBSIM_BUILD_SIM_RFB + " and " +
+                             RFBSIM_INSTALLED_SIM_RFB + "); build it or give --session-command");
+  }
+  if (!is_executable(command)) {
+    throw std::runtime_error("session command '" + command + "' is not an executable file (give a full path)");
+  }
+  return std::filesystem::absolute(command).string();
+}
+
+std::string resolve_web_root(const std::string& requested) {
+  std::vector<std::string> candidates;
+  if (!requested.empty()) {
+    candidates.push_back(requested);
+  } else {
+    candidates = {RFBSIM_BUILD_WEB_ROOT, RFBSIM_INSTALLED_WEB_ROOT};
+  }
+  for (const std::string& candidate : candidates) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(std::filesystem::path(candidate) / "index.html", ec)) return candidate;
+  }
+  throw std::runtime_error("no participant page found in " + candidates.front() +
+                           (requested.empty() ? std::string(" or ") + RFBSIM_INSTALLED_WEB_ROOT : "") +
+                           "; build the web target or give --web-root");
+}
+
+int run(ManagerConfig config) {
+  namespace manager = rfbsim::manager;
+  const std::string program = resolve_program(config.session_command);
+  const std::string web_root = resolve_web_root(config.web_root);
+  if (config.host_id.empty()) config.host_id = default_host_id();
+  std::filesystem::create_directories(std::filesystem::path(config.data_dir) / "sessions");
+  manager::SessionIndex index((std::filesystem::path(config.data_dir) / "sessions.db").string());
+
+  // The relays see a vanished browser as an error code, never as a signal.
+  std::signal(SIGPIPE, SIG_IGN);
+  boost::asio::io_context io;
+  manager::Metrics metrics;
+  manager::Supervisor supervisor(io, config, program, index, metrics);
+  if (const int interrupted = supervisor.recover_interrupted(); interrupted > 0) {
+    std::fprintf(stderr, "[manager] marked %d session(s) left by the previous run as interrupted\n", interrupted);
+  }
+  const auto frontend = manager::make_frontend(io, config, supervisor, metrics, web_root);
+
+  // SIGINT / SIGTERM: stop taking connections, end every session, then leave.
+  boost::asio::signal_set stop_signals(io, SIGINT, SIGTERM);
+  stop_signals.async_wait([&](const boost::system::error_code& ec, int signal) {
+    if (ec) return;
+    std::fprintf(stderr, "[manager] signal %d: ending %zu session(s)\n", signal, supervisor.table().size());
+    frontend->stop();
+    supervisor.shutdown([&io] { io.stop(); });
+  });
+
+  const std::string host = config.listen_address == "0.0.0.0" ? "127.0.0.1" : config.listen_address;
+  const std::string base = std::string(frontend->scheme()) + "://" + host + ":" + std::to_string(frontend->port());
+  std::string example = "uid=demo&scenario=" + manager::scenario_names(config.scenarios).front();
+  if (!config.link_secret.empty()) example = manager::sign_query(example, config.link_secret);
+  std::fprintf(stderr, "[manager] sessions: %s (%s), at most %d, %lld s each, idle timeout %lld s; data in %s\n",
+               program.c_str(), manager::session_kind_name(config.session_kind), config.max_sessions,
+               static_cast<long long>(config.max_duration.count()),
+               static_cast<long long>(config.idle_timeout.count()), config.data_dir.c_str());
+  std::printf("sim_manager ready: %s/\nparticipant link: %s/start?%s\n", base.c_str(), base.c_str(), example.c_str());
+  std::fflush(stdout);
+  io.run();
+  std::fprintf(stderr, "[manager] stopped\n");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  namespace manager = rfbsim::manager;
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  manager::ConfigOutcome parsed = manager::parse_manager_args(args, environment_variables());
+  if (parsed.help) {
+    std::fputs(manager::manager_usage().c_str(), stdout);
+    return 0;
+  }
+  if (!parsed.error.empty()) {
+    std::fprintf(stderr, "sim_manager: %s\n(sim_manager --help lists the options)\n", parsed.error.c_str());
+    return 2;
+  }
+  if (!parsed.sign_query.empty()) {
+    if (parsed.config.link_secret.empty()) {
+      std::fprintf(stderr, "sim_manager: --sign needs a link secret (--link-secret, the config or RFBSIM_LINK_SECRET)\n");
+      return 2;
+    }
+    try {
+      std::printf("%s\n", manager::sign_query(parsed.sign_query, parsed.config.link_secret).c_str());
+      return 0;
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "sim_manager: --sign: %s\n", error.what());
+      return 2;
+    }
+  }
+  try {
+    return run(std::move(parsed.config));
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "sim_manager: error: %s\n", error.what());
+    return 1;
+  }
+}

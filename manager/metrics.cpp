@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Prometheus text for the manager's counters.
+#include "metrics.hpp"
+
+#include <cstdio>
+
+namespace rfbsim::manager {
+
+namespace {
+
+constexpr Rejection kAllRejections[] = {
+    Rejection::kBusy,           Rejection::kBadRequest,   Rejection::kBadSignature,
+    Rejection::kCompleted,      Rejection::kUnknownSession, Rejection::kEndedSession,
+    Rejection::kForbiddenOrigin, Rejection::kUnauthorized, Rejection::kStartFailed};
+
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+void header(std::string& out, const char* name, const char* type, const char* help) {
+  out += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n";
+}
+
+}  // namespace
+
+const char* rejection_name(Rejection reason) {
+  switch (reason) {
+    case Rejection::kBusy: return "busy";
+    case Rejection::kBadRequest: return "bad_request";
+    case Rejection::kBadSignature: return "bad_signature";
+    case Rejection::kCompleted: return "already_completed";
+    case Rejection::kUnknownSession: return "unknown_session";
+    case Rejection::kEndedSession: return "ended_session";
+    case Rejection::kForbiddenOrigin: return "forbidden_origin";
+    case Rejection::kUnauthorized: return "unauthorized";
+    case Rejection::kStartFailed: return "start_failed";
+  }
+  return "other";
+}
+
+void Metrics::observe_startup(double seconds) {
+  ++startup_count_;
+  startup_sum_ += seconds;
+  for (std::size_t i = 0; i < kStartupBuckets.size(); ++i) {
+    if (seconds <= kStartupBuckets[i]) ++startup_buckets_[i];
+  }
+}
+
+std::uint64_t Metrics::rejections(Rejection reason) const {
+  const auto it = rejections_.find(reason);
+  return it == rejections_.end() ? 0 : it->second;
+}
+
+std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions_by_state, int capacity,
+                            int relays) const {
+  std::string out;
+  header(out, "rfbsim_sessions", "gauge", "Sessions by state (live states now; ended states in the whole index).");
+  for (const SessionState state : kAllStates) {
+    const auto it = sessions_by_state.find(state);
+    out += std::string("rfbsim_sessions{state=\"") + state_name(state) + "\"} " +
+           std::to_string(it == sessions_by_state.end() ? 0 : it->second) + "\n";
+  }
+  header(out, "rfbsim_session_capacity", "gauge", "Live sessions allowed at once.");
+  out += "rfbsim_session_capacity " + std::to_string(capacity) + "\n";
+  header(out, "rfbsim_session_starts_total", "counter", "Sessions started since the manager started.");
+  out += "rfbsim_session_starts_total " + std::to_string(starts_) + "\n";
+  header(out, "rfbsim_session_startup_seconds", "histogram", "Time from /start to the session being ready.");
+  for (std::size_t i = 0; i < kStartupBuckets.size(); ++i) {
+    out += "rfbsim_session_startup_seconds_bucket{le=\"" + number(kStartupBuckets[i]) + "\"} " +
+           std::to_string(startup_buckets_[i]) + "\n";
+  }
+  out += "rfbsim_session_startup_seconds_bucket{le=\"+Inf\"} " + std::to_string(startup_count_) + "\n";
+  out += "rfbsim_session_startup_seconds_sum " + number(startup_sum_) + "\n";
+  out += "rfbsim_session_startup_seconds_count " + std::to_string(startup_count_) + "\n";
+  header(out, "rfbsim_relay_bytes_total", "counter", "Bytes relayed between browsers and sessions.");
+  out += "rfbsim_relay_bytes_total{direction=\"to_client\"} " + std::to_string(bytes_to_client_) + "\n";
+  out += "rfbsim_relay_bytes_total{direction=\"to_session\"} " + std::to_string(bytes_to_session_) + "\n";
+  header(out, "rfbsim_relay_connections", "gauge", "WebSocket relays open now.");
+  out += "rfbsim_relay_connections " + std::to_string(relays) + "\n";
+  header(out, "rfbsim_relay_connections_total", "counter", "WebSocket relays opened since the manager started.");
+  out += "rfbsim_relay_connections_total " + std::to_string(relays_opened_) + "\n";
+  header(out, "rfbsim_rejections_total", "counter", "Requests turned away, by reason.");
+  for (const Rejection reason : kAllRejections) {
+    out += std::string("rfbsim_rejections_total{reason=\"") + rejection_name(reason) + "\"} " +
+           std::to_string(rejections(reason)) + "\n";
+  }
+  return out;
+}
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The manager's counters and their Prometheus text exposition (format 0.0.4). Pure: no I/O.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "session.hpp"
+
+namespace rfbsim::manager {
+
+/// Why a request was turned away; each a label value of rfbsim_rejections_total.
+enum class Rejection {
+  kBusy,            ///< every slot taken
+  kBadRequest,      ///< a malformed or invalid parameter, path or header
+  kBadSignature,    ///< signing is on and sig is missing or wrong
+  kCompleted,       ///< the uid's session already ran its course
+  kUnknownSession,  ///< a token that names no session
+  kEndedSession,    ///< a token whose session has ended
+  kForbiddenOrigin, ///< a WebSocket from an origin not allowed
+  kUnauthorized,    ///< admin routes without the right token
+  kStartFailed,     ///< the session program could not be started
+};
+
+const char* rejection_name(Rejection reason);
+
+/// Counters since the manager started; the session gauges are read from the table when rendered.
+class Metrics {
+ public:
+  /// Upper bounds of the start-up histogram's buckets, seconds.
+  static constexpr std::array<double, 10> kStartupBuckets = {0.1, 0.2, 0.3, 0.5, 0.75, 1, 2, 5, 10, 30};
+
+  void count_start() { ++starts_; }
+  void count_rejection(Rejection reason) { ++rejections_[reason]; }
+  /// A session became ready `seconds` after /start accepted it.
+  void observe_startup(double seconds);
+  void add_bytes_to_client(std::uint64_t bytes) { bytes_to_client_ += bytes; }
+  void add_bytes_to_session(std::uint64_t bytes) { bytes_to_session_ += bytes; }
+  void count_relay_open() { ++relays_opened_; }
+
+  [[nodiscard]] std::uint64_t starts() const { return starts_; }
+  [[nodiscard]] std::uint64_t rejections(Rejection reason) const;
+  [[nodiscard]] std::uint64_t bytes_to_client() const { return bytes_to_client_; }
+
+  /// The exposition text. `sessions_by_state`: live sessions by state now, and ended ones by state over
+  /// the whole index; `relays`: WebSocket relays open now.
+  [[nodiscard]] std::string render(const std::map<SessionState, std::int64_t>& sessions_by_state, int capacity,
+                                   int relays) const;
+
+ private:
+  std::uint64_t starts_ = 0;
+  std::map<Rejection, std::uint64_t> rejections_;
+  std::array<std::uint64_t, kStartupBuckets.size()> startup_buckets_{};
+  std::uint64_t startup_count_ = 0;
+  double startup_sum_ = 0;
+  std::uint64_t bytes_to_client_ = 0;
+  std::uint64_t bytes_to_session_ = 0;
+  std::uint64_t relays_opened_ = 0;
+};
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,26 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The small HTML pages the manager answers with itself: home, busy, already completed, session ended and
+// errors. Written for participants (plain words, no jargon) and safe to show in a survey iframe. Pure.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace rfbsim::manager {
+
+/// GET /: what this server is.
+std::string home_page();
+
+/// Every simulator is busy: the page reloads itself (retrying the same link) after `retry_seconds`.
+std::string busy_page(int retry_seconds);
+
+/// The uid's session already ran its course.
+std::string completed_page();
+
+/// The session behind a link has ended (`state` in words, e.g. "expired").
+std::string session_ended_page(std::string_view state);
+
+/// Any other refusal: a title and a message (escaped here).
+std::string error_page(int status, std::string_view title, std::string_view message);
+
+}  // namespace rfbsim::manager

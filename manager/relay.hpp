@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Relay: one browser WebSocket carried to one session's loopback port as raw RFB, byte for byte.
+//
+// Flow control keeps a slow browser from growing the manager's memory: while more than kMaxBuffered bytes
+// wait in the WebSocket's send buffer, the relay stops reading from the session, so TCP pushes back and
+// the session's own flow control gives that participant fewer, current frames. Input from the browser
+// is small (keys); more than kMaxPending unsent bytes of it means a broken client, and it is closed.
+//
+// Templated on the websocketpp server type (plain or TLS); everything runs on the I/O thread.
+#pragma once
+
+#include <array>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/write.hpp>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <string>
+#include <websocketpp/close.hpp>
+#include <websocketpp/common/connection_hdl.hpp>
+#include <websocketpp/frame.hpp>
+
+#include "metrics.hpp"
+
+namespace rfbsim::manager {
+
+template <typename Server>
+class Relay : public std::enable_shared_from_this<Relay<Server>> {
+ public:
+  static constexpr std::size_t kMaxBuffered = 1 << 20;
+  static constexpr std::size_t kMaxPending = 1 << 20;
+  static constexpr auto kDrainPoll = std::chrono::milliseconds(5);
+
+  /// Called once when the session side closes or fails (not when close() was called first).
+  using UpstreamLost = std::function<void(Relay&)>;
+
+  Relay(Server& server, websocketpp::connection_hdl browser, std::int64_t session_id, std::string token,
+        Metrics& metrics, UpstreamLost on_upstream_lost)
+      : server_(server),
+        browser_(std::move(browser)),
+        session_id_(session_id),
+        token_(std::move(token)),
+        metrics_(metrics),
+        on_upstream_lost_(std::move(on_upstream_lost)),
+        upstream_(server.get_io_service()),
+        drain_timer_(server.get_io_service()) {}
+
+  [[nodiscard]] std::int64_t session_id() const { return session_id_; }
+  [[nodiscard]] const std::string& token() const { return token_; }
+  [[nodiscard]] bool connecting_or_connected() const { return connect_started_; }
+
+  /// Connects to the session's port and starts relaying (browser bytes received so far go first).
+  void connect(int port) {
+    if (connect_started_ || closed_) return;
+    connect_started_ = true;
+    const boost::asio::ip::tcp::endpoint endpoint(boost::asio::ip::address_v4::loopback(),
+                                                  static_cast<unsigned short>(port));
+    upstream_.async_connect(endpoint, [self = this->shared_from_this()](const boost::system::error_code& ec) {
+      if (self->closed_) return;
+      if (ec) {
+        self->lose_upstream();
+        return;
+      }
+      boost::system::error_code ignored;
+      self->upstream_.set_option(boost::asio::ip::tcp::no_delay(true), ignored);
+      self->connected_ = true;
+      self->write_upstream();
+      self->read_upstream();
+    });
+  }
+
+  /// A binary message from the browser: raw RFB bytes for the session.
+  void from_browser(std::string payload) {
+    if (closed_) return;
+    pending_bytes_ += payload.size();
+    if (pending_bytes_ > kMaxPending) {
+      close(websocketpp::close::status::message_too_big, "too much input");
+      return;
+    }
+    pending_.push_back(std::move(payload));
+    write_upstream();
+  }
+
+  /// Closes both sides: the browser with `code` and `reason` (if still open), the session's socket.
+  void close(websocketpp::close::status::value code, const std::string& reason) {
+    if (closed_) return;
+    closed_ = true;
+    boost::system::error_code ignored;
+    drain_timer_.cancel();
+    upstream_.close(ignored);
+    websocketpp::lib::error_code ec;
+    auto connection = server_.get_con_from_hdl(browser_, ec);
+    if (!ec && connection->get_state() == websocketpp::session::state::open) connection->close(code, reason, ec);
+  }
+
+  /// The browser's side is gone: drop the session's socket too.
+  void browser_gone() {
+    closed_ = true;
+    boost::system::error_code ignored;
+    drain_timer_.cancel();
+    upstream_.close(ignored);
+  }
+
+ private:
+  void lose_upstream() {
+    if (closed_ || upstream_lost_) return;
+    upstream_lost_ = true;
+    if (on_upstream_lost_) on_upstream_lost_(*this);
+  }
+
+  void read_upstream() {
+    upstream_.async_read_some(boost::asio::buffer(buffer_), [self = this->shared_from_this()](
+                                                                const boost::system::error_code& ec,
+                                                                std::size_t bytes) {
+      if (self->closed_) return;
+      if (ec) {
+        self->lose_upstream();
+        return;
+      }
+      websocketpp::lib::error_code send_ec;
+      auto connection = self->server_.get_con_from_hdl(self->browser_, send_ec);
+      if (send_ec) return;
+      send_ec = connection->send(self->buffer_.data(), bytes, websocketpp::frame::opcode::binary);
+      if (send_ec) return;  // the browser is going; its close handler cleans up
+      self->metrics_.add_bytes_to_client(bytes);
+      self->read_when_drained();
+    });
+  }
+
+  // Reads the next chunk once the browser has taken most of what was sent.
+  void read_when_drained() {
+    websocketpp::lib::error_code ec;
+    auto connection = server_.get_con_from_hdl(browser_, ec);
+    if (ec || closed_) return;
+    if (connection->get_buffered_amount() <= kMaxBuffered) {
+      read_upstream();
+      return;
+    }
+    drain_timer_.expires_after(kDrainPoll);
+    drain_timer_.async_wait([self = this->shared_from_this()](const boost::system::error_code& wait_ec) {
+      if (!wait_ec) self->read_when_drained();
+    });
+  }
+
+  void write_upstream() {
+    if (!connected_ || writing_ || pending_.empty() || closed_) return;
+    writing_ = true;
+    boost::asio::async_write(upstream_, boost::asio::buffer(pending_.front()),
+                             [self = this->shared_from_this()](const boost::system::error_code& ec, std::size_t bytes) {
+                               self->writing_ = false;
+                               if (self->closed_) return;
+                               if (ec) {
+                                 self->lose_upstream();
+                                 return;
+                               }
+                               self->metrics_.add_bytes_to_session(bytes);
+                               self->pending_bytes_ -= self->pending_.front().size();
+                               self->pending_.pop_front();
+                               self->write_upstream();
+                             });
+  }
+
+  Server& server_;
+  websocketpp::connection_hdl browser_;
+  std::int64_t session_id_;
+  std::string token_;
+  Metrics& metrics_;
+  UpstreamLost on_upstream_lost_;
+  boost::asio::ip::tcp::socket upstream_;
+  boost::asio::steady_timer drain_timer_;
+  std::array<char, 64 * 1024> buffer_{};
+  std::deque<std::string> pending_;
+  std::size_t pending_bytes_ = 0;
+  bool connect_started_ = false;
+  bool connected_ = false;
+  bool writing_ = false;
+  bool closed_ = false;
+  bool upstream_lost_ = false;
+};
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Request routing for sim_manager.
+#include "routes.hpp"
+
+#include <charconv>
+
+#include "query.hpp"
+
+namespace rfbsim::manager {
+
+namespace {
+
+constexpr std::size_t kTokenLength = 32;
+
+Route with_method(Route route, std::string_view method, std::string_view wanted) {
+  if (method != wanted && !(wanted == "GET" && method == "HEAD")) route.kind = RouteKind::kBadMethod;
+  return route;
+}
+
+}  // namespace
+
+bool is_token(std::string_view text) {
+  if (text.size() != kTokenLength) return false;
+  for (const char ch : text) {
+    if (!((ch >= '0' && ch <= '9') || (ch >= 'a' && ch <= 'f'))) return false;
+  }
+  return true;
+}
+
+Route route_request(std::string_view method, std::string_view target) {
+  const auto [path, query] = split_target(target);
+  Route route;
+  route.query = std::string(query);
+  if (path == "/") {
+    route.kind = RouteKind::kHome;
+    return with_method(route, method, "GET");
+  }
+  if (path == "/start") {
+    route.kind = RouteKind::kStart;
+    return with_method(route, method, "GET");
+  }
+  if (path == "/healthz") {
+    route.kind = RouteKind::kHealth;
+    return with_method(route, method, "GET");
+  }
+  if (path == "/metrics") {
+    route.kind = RouteKind::kMetrics;
+    return with_method(route, method, "GET");
+  }
+  if (path == "/admin" || path == "/admin/") {
+    route.kind = RouteKind::kAdminPage;
+    return with_method(route, method, "GET");
+  }
+  if (path.rfind("/admin/", 0) == 0) {
+    route.kind = RouteKind::kAdminPage;
+    route.file = std::string(path.substr(7));
+    return with_method(route, method, "GET");
+  }
+  if (path == "/api/sessions") {
+    route.kind = RouteKind::kApiSessions;
+    return with_method(route, method, "GET");
+  }
+  constexpr std::string_view kApiPrefix = "/api/sessions/";
+  constexpr std::string_view kEndSuffix = "/end";
+  if (path.rfind(kApiPrefix, 0) == 0 && path.size() > kApiPrefix.size() + kEndSuffix.size() &&
+      path.substr(path.size() - kEndSuffix.size()) == kEndSuffix) {
+    const std::string_view id = path.substr(kApiPrefix.size(), path.size() - kApiPrefix.size() - kEndSuffix.size());
+    std::int64_t value = 0;
+    const auto [ptr, ec] = std::from_chars(id.data(), id.data() + id.size(), value);
+    if (ec != std::errc() || ptr != id.data() + id.size() || value <= 0 || id.front() == '+') return route;
+    route.kind = RouteKind::kApiEndSession;
+    route.session_id = value;
+    return with_method(route, method, "POST");
+  }
+  // /s/<token>/ and what lies below it.
+  constexpr std::string_view kSessionPrefix = "/s/";
+  if (path.rfind(kSessionPrefix, 0) == 0) {
+    const std::string_view rest = path.substr(kSessionPrefix.size());
+    const std::size_t slash = rest.find('/');
+    if (slash == std::string_view::npos || !is_token(rest.substr(0, slash))) return route;
+    route.token = std::string(rest.substr(0, slash));
+    const std::string_view below = rest.substr(slash + 1);
+    if (below == "ws") {
+      route.kind = RouteKind::kSessionSocket;
+    } else if (below == "status") {
+      route.kind = RouteKind::kSessionStatus;
+    } else {
+      route.kind = RouteKind::kSessionFile;
+      route.file = std::string(below);
+    }
+    return with_method(route, method, "GET");
+  }
+  return route;
+}
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// One participant's session as the manager keeps it, and the rules of its life cycle. Pure: no I/O.
+//
+//   starting --ready--> running --exit 0--> finished
+//      |                  |  \--other exit--> crashed
+//      |                  \--expiry / idle / admin / shutdown--> ending --exit--> expired | idle | ended | shutdown
+//      \--exit or start timeout--> failed
+// A session found live in the index by a manager that restarted is marked interrupted.
+#pragma once
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace rfbsim::manager {
+
+enum class SessionState {
+  kStarting,     ///< process started, not yet ready
+  kRunning,      ///< ready: its port takes connections
+  kEnding,       ///< told to stop (SIGTERM), not yet gone
+  kFinished,     ///< the program ended by itself with status 0
+  kExpired,      ///< ended at the maximum duration
+  kIdle,         ///< ended after the idle timeout (no browser connected)
+  kEnded,        ///< ended by an administrator
+  kShutdown,     ///< ended because the manager stopped
+  kCrashed,      ///< the program died on its own (signal or non-zero status) while running
+  kFailed,       ///< never became ready (bad parameters, start timeout, cannot run)
+  kInterrupted,  ///< the manager died while it ran; found and ended by the next manager
+};
+
+/// Every state, for metrics that list them all.
+inline constexpr SessionState kAllStates[] = {
+    SessionState::kStarting, SessionState::kRunning, SessionState::kEnding,  SessionState::kFinished,
+    SessionState::kExpired,  SessionState::kIdle,    SessionState::kEnded,   SessionState::kShutdown,
+    SessionState::kCrashed,  SessionState::kFailed,  SessionState::kInterrupted};
+
+/// "starting", "running", ... as stored in the index and shown in metrics.
+const char* state_name(SessionState state);
+std::optional<SessionState> state_from_name(std::string_view name);
+
+/// Starting, running or ending: the session holds a slot and a process.
+bool is_live(SessionState state);
+
+/// A session that ran its course (finished, expired, idle, ended): its uid may not start again unless
+/// repeats are allowed. Crashed, failed, interrupted and shutdown sessions were not the participant's
+/// doing, so the same link may start afresh.
+bool counts_as_completed(SessionState state);
+
+using WallTime = std::chrono::system_clock::time_point;
+
+/// One session: the model (who, what) and where it stands.
+struct Session {
+  std::int64_t id = 0;          ///< index row id, from 1
+  std::string uid;              ///< participant id (validated identifier)
+  std::string token;            ///< 32 hex digits: 128 random bits, the capability to reach the session
+  std::string scenario;
+  std::string params_json;      ///< the link's parameters (sig left out), as a JSON object
+  std::uint64_t seed = 0;
+  std::string host_id;
+  SessionState state = SessionState::kStarting;
+  SessionState end_as = SessionState::kEnded;  ///< while ending: the state it gets when the process is gone
+  std::string detail;           ///< why it ended, in words ("exit status 2: ...", "killed by signal 9")
+  std::string exit_status;      ///< "exit 0", "signal 9", "" while running
+  pid_t pid = -1;               ///< also the process group id (the session leads its own group)
+  std::int64_t process_start = 0;  ///< the process's start time in clock ticks (/proc), to recognise it later
+  int port = 0;                 ///< loopback port the session serves RFB on, once known
+  std::string data_path;        ///< the session's folder
+  WallTime created{};           ///< /start accepted
+  std::optional<WallTime> ready_at;  ///< the program reported ready
+  std::optional<WallTime> ended_at;  ///< the process was gone
+};
+
+/// Moves a starting or running session to ending, to become `end_as` once its process is gone.
+/// Returns false (and changes nothing) if it is not starting or running.
+bool begin_ending(Session& session, SessionState end_as, std::string detail);
+
+/// The state a live session takes when its process exits with `wait_status` (as from waitpid).
+SessionState state_after_exit(const Session& session, int wait_status);
+
+/// "exit 3" or "signal 9" for a wait status.
+std::string describe_wait_status(int wait_status);
+
+/// What admitting a /start for a uid comes to.
+enum class Admission {
+  kJoinLive,          ///< the uid has a live session: back to it
+  kAlreadyCompleted,  ///< the uid's last session ran its course and repeats are not allowed
+  kBusy,              ///< no free slot
+  kStartNew,          ///< start a session
+};
+
+/// The admission rule. `has_live`: the uid has a live session; `last_state`: the state of its latest
+/// session that is not live, if any; `full`: every slot taken.
+Admission admit(bool has_live, std::optional<SessionState> last_state, bool allow_repeat, bool full);
+
+}  // namespace rfbsim::manager

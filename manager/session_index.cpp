@@ -1,0 +1,249 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The session index in SQLite.
+#include "session_index.hpp"
+
+#include <sqlite3.h>
+
+#include <cstdio>
+#include <ctime>
+#include <stdexcept>
+
+namespace rfbsim::manager {
+
+namespace {
+
+constexpr const char* kSchema = R"sql(
+CREATE TABLE IF NOT EXISTS sessions (
+  id            INTEGER PRIMARY KEY AUTOINCREMENT,
+  uid           TEXT NOT NULL,
+  token         TEXT NOT NULL UNIQUE,
+  scenario      TEXT NOT NULL,
+  params        TEXT NOT NULL,          -- the link's parameters, a JSON object
+  seed          TEXT NOT NULL,          -- decimal: seeds are unsigned 64-bit
+  host_id       TEXT NOT NULL,
+  state         TEXT NOT NULL,          -- starting running ending finished expired idle ended shutdown
+                                        -- crashed failed interrupted
+  detail        TEXT NOT NULL DEFAULT '',
+  exit_status   TEXT NOT NULL DEFAULT '',  -- "exit N" or "signal N" once the process is gone
+  outcome       TEXT,                   -- the study task's outcome, written by the simulator's tooling
+  pid           INTEGER,                -- also the process group id
+  process_start INTEGER,                -- /proc start time in clock ticks: recognises the process later
+  port          INTEGER,
+  data_path     TEXT NOT NULL DEFAULT '',
+  created_at    TEXT NOT NULL,          -- ISO 8601 UTC
+  ready_at      TEXT,
+  ended_at      TEXT
+);
+CREATE INDEX IF NOT EXISTS sessions_by_uid ON sessions (uid, id);
+CREATE INDEX IF NOT EXISTS sessions_by_state ON sessions (state);
+)sql";
+
+constexpr const char* kColumns =
+    "id, uid, token, scenario, params, seed, host_id, state, detail, exit_status, pid, process_start, port, "
+    "data_path, created_at, ready_at, ended_at";
+
+// One prepared statement, finalized on scope exit.
+class Statement {
+ public:
+  Statement(sqlite3* db, const std::string& sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt_, nullptr) != SQLITE_OK) {
+      throw std::runtime_error(std::string("session index: ") + sqlite3_errmsg(db));
+    }
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+
+  void bind(int index, const std::string& text) {
+    sqlite3_bind_text(stmt_, index, text.c_str(), static_cast<int>(text.size()), SQLITE_TRANSIENT);
+  }
+  void bind(int index, std::int64_t value) { sqlite3_bind_int64(stmt_, index, value); }
+  void bind(int index, const std::optional<WallTime>& time) {
+    if (time) {
+      bind(index, iso_utc(*time));
+    } else {
+      sqlite3_bind_null(stmt_, index);
+    }
+  }
+  // Returns true while there is a row; throws on errors.
+  bool step() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw std::runtime_error(std::string("session index: ") + sqlite3_errmsg(db_));
+  }
+  std::string text(int column) {
+    const auto* value = sqlite3_column_text(stmt_, column);
+    return value == nullptr ? std::string() : std::string(reinterpret_cast<const char*>(value));
+  }
+  std::int64_t integer(int column) { return sqlite3_column_int64(stmt_, column); }
+  bool is_null(int column) { return sqlite3_column_type(stmt_, column) == SQLITE_NULL; }
+
+ private:
+  sqlite3* db_;
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+Session read_row(Statement& row) {
+  Session s;
+  s.id = row.integer(0);
+  s.uid = row.text(1);
+  s.token = row.text(2);
+  s.scenario = row.text(3);
+  s.params_json = row.text(4);
+  s.seed = std::strtoull(row.text(5).c_str(), nullptr, 10);
+  s.host_id = row.text(6);
+  s.state = state_from_name(row.text(7)).value_or(SessionState::kInterrupted);
+  s.detail = row.text(8);
+  s.exit_status = row.text(9);
+  s.pid = static_cast<pid_t>(row.integer(10));
+  s.process_start = row.integer(11);
+  s.port = static_cast<int>(row.integer(12));
+  s.data_path = row.text(13);
+  s.created = parse_iso_utc(row.text(14)).value_or(WallTime{});
+  if (!row.is_null(15)) s.ready_at = parse_iso_utc(row.text(15));
+  if (!row.is_null(16)) s.ended_at = parse_iso_utc(row.text(16));
+  return s;
+}
+
+}  // namespace
+
+std::string iso_utc(WallTime time) {
+  const auto since_epoch = std::chrono::duration_cast<std::chrono::milliseconds>(time.time_since_epoch());
+  const std::time_t seconds = static_cast<std::time_t>(since_epoch.count() / 1000);
+  const int millis = static_cast<int>(since_epoch.count() % 1000);
+  std::tm parts{};
+  gmtime_r(&seconds, &parts);
+  char text[64];
+  std::snprintf(text, sizeof text, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", parts.tm_year + 1900, parts.tm_mon + 1,
+                parts.tm_mday, parts.tm_hour, parts.tm_min, parts.tm_sec, millis);
+  return text;
+}
+
+std::optional<WallTime> parse_iso_utc(const std::string& text) {
+  std::tm parts{};
+  int millis = 0;
+  char zone = 0;
+  if (std::sscanf(text.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d.%3d%c", &parts.tm_year, &parts.tm_mon, &parts.tm_mday,
+                  &parts.tm_hour, &parts.tm_min, &parts.tm_sec, &millis, &zone) != 8 ||
+      zone != 'Z') {
+    return std::nullopt;
+  }
+  parts.tm_year -= 1900;
+  parts.tm_mon -= 1;
+  const std::time_t seconds = timegm(&parts);
+  return WallTime(std::chrono::duration_cast<WallTime::duration>(std::chrono::seconds(seconds) +
+                                                                 std::chrono::milliseconds(millis)));
+}
+
+SessionIndex::SessionIndex(const std::string& path) : path_(path) {
+  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
+                      nullptr) != SQLITE_OK) {
+    const std::string message = db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw std::runtime_error("session index " + path + ": " + message);
+  }
+  try {
+    // Another reader (a researcher's sqlite3 shell) may hold a lock for a moment: wait rather than fail.
+    sqlite3_busy_timeout(db_, 5000);
+    exec("PRAGMA journal_mode = WAL");
+    exec("PRAGMA synchronous = FULL");
+    exec(kSchema);
+  } catch (const std::exception& error) {
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw std::runtime_error("session index " + path + ": " + error.what());
+  }
+}
+
+SessionIndex::~SessionIndex() { sqlite3_close(db_); }
+
+void SessionIndex::exec(const char* sql) {
+  char* message = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &message) != SQLITE_OK) {
+    const std::string text = message != nullptr ? message : "unknown error";
+    sqlite3_free(message);
+    throw std::runtime_error(text);
+  }
+}
+
+std::int64_t SessionIndex::insert(const Session& s) {
+  Statement insert(db_,
+                   "INSERT INTO sessions (uid, token, scenario, params, seed, host_id, state, detail, pid, "
+                   "process_start, port, data_path, created_at) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?)");
+  insert.bind(1, s.uid);
+  insert.bind(2, s.token);
+  insert.bind(3, s.scenario);
+  insert.bind(4, s.params_json);
+  insert.bind(5, std::to_string(s.seed));
+  insert.bind(6, s.host_id);
+  insert.bind(7, std::string(state_name(s.state)));
+  insert.bind(8, s.detail);
+  insert.bind(9, static_cast<std::int64_t>(s.pid));
+  insert.bind(10, s.process_start);
+  insert.bind(11, static_cast<std::int64_t>(s.port));
+  insert.bind(12, s.data_path);
+  insert.bind(13, iso_utc(s.created));
+  insert.step();
+  return sqlite3_last_insert_rowid(db_);
+}
+
+void SessionIndex::update(const Session& s) {
+  Statement update(db_,
+                   "UPDATE sessions SET state = ?, detail = ?, exit_status = ?, pid = ?, process_start = ?, "
+                   "port = ?, data_path = ?, ready_at = ?, ended_at = ? WHERE id = ?");
+  update.bind(1, std::string(state_name(s.state)));
+  update.bind(2, s.detail);
+  update.bind(3, s.exit_status);
+  update.bind(4, static_cast<std::int64_t>(s.pid));
+  update.bind(5, s.process_start);
+  update.bind(6, static_cast<std::int64_t>(s.port));
+  update.bind(7, s.data_path);
+  update.bind(8, s.ready_at);
+  update.bind(9, s.ended_at);
+  update.bind(10, s.id);
+  update.step();
+  if (sqlite3_changes(db_) != 1) {
+    throw std::runtime_error("session index: no session " + std::to_string(s.id) + " to update");
+  }
+}
+
+std::vector<Session> SessionIndex::query(const std::string& where, const std::vector<std::string>& binds) {
+  Statement select(db_, std::string("SELECT ") + kColumns + " FROM sessions " + where);
+  for (std::size_t i = 0; i < binds.size(); ++i) select.bind(static_cast<int>(i + 1), binds[i]);
+  std::vector<Session> rows;
+  while (select.step()) rows.push_back(read_row(select));
+  return rows;
+}
+
+std::optional<Session> SessionIndex::latest_for_uid(const std::string& uid) {
+  auto rows = query("WHERE uid = ? ORDER BY id DESC LIMIT 1", {uid});
+  if (rows.empty()) return std::nullopt;
+  return std::move(rows.front());
+}
+
+std::optional<Session> SessionIndex::find_by_token(const std::string& token) {
+  auto rows = query("WHERE token = ?", {token});
+  if (rows.empty()) return std::nullopt;
+  return std::move(rows.front());
+}
+
+std::vector<Session> SessionIndex::live_sessions(const std::string& host_id) {
+  return query("WHERE host_id = ? AND state IN ('starting', 'running', 'ending') ORDER BY id", {host_id});
+}
+
+std::vector<Session> SessionIndex::recent(int limit) {
+  return query("ORDER BY id DESC LIMIT " + std::to_string(limit), {});
+}
+
+std::vector<std::pair<SessionState, std::int64_t>> SessionIndex::count_by_state() {
+  Statement select(db_, "SELECT state, COUNT(*) FROM sessions GROUP BY state");
+  std::vector<std::pair<SessionState, std::int64_t>> counts;
+  while (select.step()) {
+    if (const auto state = state_from_name(select.text(0))) counts.emplace_back(*state, select.integer(1));
+  }
+  return counts;
+}
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,170 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Validation of /start links.
+#include "start_request.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+namespace rfbsim::manager {
+
+const std::vector<OverrideParam> kOverrideParams = {
+    {"avatar_start", "--avatar-start"}, {"avatar_goal", "--avatar-goal"}, {"robot_start", "--robot-start"},
+    {"robot_goal", "--robot-goal"},     {"crowd", "--crowd"},
+};
+
+namespace {
+
+constexpr std::size_t kMaxIdentifier = 64;
+// Maps are tens of metres; anything beyond this is a typo or an attack, not a pose.
+constexpr double kMaxCoordinate = 10000.0;
+constexpr double kMaxYaw = 7.0;  // a little over 2 pi
+constexpr int kMaxCrowd = 500;  // sim_rfb's own bound
+
+// "-12.5": an optional minus, digits, optionally a point and digits. No exponents, spaces or "+".
+std::optional<double> strict_decimal(std::string_view text) {
+  if (text.empty() || text.size() > 16) return std::nullopt;
+  std::size_t i = text[0] == '-' ? 1 : 0;
+  bool digits_before = false;
+  while (i < text.size() && text[i] >= '0' && text[i] <= '9') {
+    ++i;
+    digits_before = true;
+  }
+  if (!digits_before) return std::nullopt;
+  if (i < text.size()) {
+    if (text[i] != '.' || i + 1 == text.size()) return std::nullopt;
+    for (++i; i < text.size(); ++i) {
+      if (text[i] < '0' || text[i] > '9') return std::nullopt;
+    }
+  }
+  double value = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+bool is_count(std::string_view text, int high) {
+  if (text.empty() || text.size() > 4) return false;
+  int value = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  return ec == std::errc() && ptr == text.data() + text.size() && value >= 0 && value <= high;
+}
+
+std::optional<std::uint64_t> strict_seed(std::string_view text) {
+  if (text.empty() || text.size() > 20) return std::nullopt;
+  for (const char ch : text) {
+    if (ch < '0' || ch > '9') return std::nullopt;
+  }
+  std::uint64_t value = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || ptr != text.data() + text.size()) return std::nullopt;
+  return value;
+}
+
+// Parameter values are echoed in error pages: cut them short (pages escape them too).
+std::string shown(const std::string& value) { return value.size() > 40 ? value.substr(0, 40) + "..." : value; }
+
+}  // namespace
+
+bool is_identifier(std::string_view text) {
+  if (text.empty() || text.size() > kMaxIdentifier) return false;
+  return std::all_of(text.begin(), text.end(), [](char ch) {
+    return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '-' ||
+           ch == '_';
+  });
+}
+
+bool is_pose(std::string_view text) {
+  if (is_identifier(text)) return true;
+  const std::size_t first = text.find(',');
+  if (first == std::string_view::npos) return false;
+  const std::size_t second = text.find(',', first + 1);
+  if (second == std::string_view::npos || text.find(',', second + 1) != std::string_view::npos) return false;
+  const auto x = strict_decimal(text.substr(0, first));
+  const auto y = strict_decimal(text.substr(first + 1, second - first - 1));
+  const auto yaw = strict_decimal(text.substr(second + 1));
+  return x && y && yaw && std::fabs(*x) <= kMaxCoordinate && std::fabs(*y) <= kMaxCoordinate &&
+         std::fabs(*yaw) <= kMaxYaw;
+}
+
+std::vector<std::string> scenario_names(const std::vector<std::string>& entries) {
+  std::vector<std::string> names;
+  for (const std::string& entry : entries) names.push_back(entry.substr(0, entry.find('=')));
+  return names;
+}
+
+std::string scenario_argument(const std::vector<std::string>& entries, const std::string& name) {
+  for (const std::string& entry : entries) {
+    const std::size_t eq = entry.find('=');
+    if (entry.substr(0, eq) == name) return eq == std::string::npos ? entry : entry.substr(eq + 1);
+  }
+  return name;
+}
+
+StartParse parse_start_request(const QueryParams& params, const std::vector<std::string>& scenarios) {
+  StartParse out;
+  StartRequest request;
+  bool have_uid = false;
+  bool have_scenario = false;
+  for (const auto& [name, value] : params) {
+    if (name == "sig") continue;
+    if (name == "uid") {
+      if (!is_identifier(value)) {
+        out.error = "uid '" + shown(value) + "' is not valid: use 1 to 64 letters, digits, '-' or '_'";
+        return out;
+      }
+      request.uid = value;
+      have_uid = true;
+    } else if (name == "scenario") {
+      if (std::find(scenarios.begin(), scenarios.end(), value) == scenarios.end() || !is_identifier(value)) {
+        std::string allowed;
+        for (const std::string& s : scenarios) allowed += (allowed.empty() ? "" : ", ") + s;
+        out.error = "scenario '" + shown(value) + "' is not offered here (allowed: " + allowed + ")";
+        return out;
+      }
+      request.scenario = value;
+      have_scenario = true;
+    } else if (name == "seed") {
+      request.seed = strict_seed(value);
+      if (!request.seed) {
+        out.error = "seed '" + shown(value) + "' is not valid: use a whole number 0..18446744073709551615";
+        return out;
+      }
+    } else {
+      const auto known = std::find_if(kOverrideParams.begin(), kOverrideParams.end(),
+                                      [&name = name](const OverrideParam& p) { return name == p.name; });
+      if (known == kOverrideParams.end()) {
+        out.error = "unknown parameter '" + shown(name) + "'";
+        return out;
+      }
+      const bool crowd = name == "crowd";
+      if (crowd ? !is_count(value, kMaxCrowd) : !is_pose(value)) {
+        out.error = name + " '" + shown(value) + "' is not valid: " +
+                    (crowd ? "use a whole number 0.." + std::to_string(kMaxCrowd)
+                           : std::string("use a spawn point's name or x,y,yaw in metres and radians"));
+        return out;
+      }
+    }
+  }
+  if (!have_uid) {
+    out.error = "the link has no uid (participant id)";
+    return out;
+  }
+  if (!have_scenario) {
+    if (scenarios.empty()) {
+      out.error = "no scenario is offered here";
+      return out;
+    }
+    request.scenario = scenarios.front();
+  }
+  // Overrides in a fixed order, so that equal links give equal command lines and index rows.
+  for (const OverrideParam& param : kOverrideParams) {
+    for (const auto& [name, value] : params) {
+      if (name == param.name) request.overrides.emplace_back(name, value);
+    }
+  }
+  out.request = std::move(request);
+  return out;
+}
+
+}  // namespace rfbsim::manager

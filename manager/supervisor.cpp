@@ -1,0 +1,477 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Session lives on the I/O thread: processes, readiness, timers, reaping, the index.
+#include "supervisor.hpp"
+
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/posix/stream_descriptor.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "launch_plan.hpp"
+#include "session_process.hpp"
+#include "tokens.hpp"
+
+namespace rfbsim::manager {
+
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+namespace asio = boost::asio;
+
+// How often a kRfb session's port is tried until it takes a connection.
+constexpr auto kPortPollInterval = std::chrono::milliseconds(20);
+
+std::uint64_t cpu_limit_seconds(const ManagerConfig& config) {
+  if (config.limits.cpu_time_factor <= 0) return 0;
+  const double seconds = static_cast<double>(config.max_duration.count()) * config.limits.cpu_time_factor +
+                         static_cast<double>(config.limits.cpu_slack.count()) +
+                         static_cast<double>(config.stop_grace.count());
+  return static_cast<std::uint64_t>(seconds);
+}
+
+// A free loopback port for a program that must be told its port (kRfb). The port is free when we look;
+// the program binds it a moment later, so a clash is possible but unlikely, and ends as a failed start.
+int pick_free_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return 0;
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  int port = 0;
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0 &&
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0) {
+    port = ntohs(address.sin_port);
+  }
+  ::close(fd);
+  return port;
+}
+
+void log_session(const Session& session, const std::string& text) {
+  std::fprintf(stderr, "[manager] session %lld (uid %s): %s\n", static_cast<long long>(session.id),
+               session.uid.c_str(), text.c_str());
+}
+
+}  // namespace
+
+// Per live session: its timers and its readiness channel.
+struct Supervisor::Runtime {
+  explicit Runtime(asio::io_context& io)
+      : expiry(io), idle(io), stop(io), start_deadline(io), poll(io), ready_pipe(io), probe(io) {}
+  asio::steady_timer expiry, idle, stop, start_deadline, poll;
+  asio::posix::stream_descriptor ready_pipe;
+  asio::ip::tcp::socket probe;  // kRfb: tries the port until it answers
+  std::array<char, 64> buffer{};
+  std::string ready_text;
+  int clients = 0;
+  SteadyClock::time_point started;
+};
+
+struct Supervisor::ChildWatch {
+  explicit ChildWatch(asio::io_context& io) : signals(io, SIGCHLD) {}
+  asio::signal_set signals;
+};
+
+Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::string program, SessionIndex& index,
+                       Metrics& metrics)
+    : io_(io),
+      config_(config),
+      program_(std::move(program)),
+      index_(index),
+      metrics_(metrics),
+      table_(config.max_sessions),
+      child_watch_(std::make_unique<ChildWatch>(io)) {
+  wait_for_children();
+}
+
+Supervisor::~Supervisor() = default;
+
+void Supervisor::wait_for_children() {
+  child_watch_->signals.async_wait([this](const boost::system::error_code& ec, int) {
+    if (ec) return;
+    reap_children();
+    wait_for_children();
+  });
+}
+
+Supervisor::Runtime& Supervisor::runtime(std::int64_t id) { return *runtimes_.at(id); }
+
+void Supervisor::save(const Session& session) {
+  try {
+    index_.update(session);
+  } catch (const std::exception& error) {
+    log_session(session, std::string("cannot write the index: ") + error.what());
+  }
+}
+
+int Supervisor::recover_interrupted() {
+  std::vector<Session> left;
+  try {
+    left = index_.live_sessions(config_.host_id);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "[manager] cannot read the index: %s\n", error.what());
+    return 0;
+  }
+  for (Session& session : left) {
+    // The group is ours if its leader is the very process we started (same start time), or if no process
+    // has that id any more (then only members of our old group can carry it). A reused id is left alone.
+    const auto start = process_start_ticks(session.pid);
+    const bool ours = session.pid > 1 && (!start || *start == session.process_start);
+    if (ours && process_group_alive(session.pid)) {
+      signal_process_group(session.pid, SIGKILL);
+      for (int i = 0; i < 100 && process_group_alive(session.pid); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));  // start-up only: nothing else runs yet
+      }
+      log_session(session, "its process was still running after a manager restart; killed");
+    }
+    session.state = SessionState::kInterrupted;
+    session.detail = "the manager stopped unexpectedly while the session ran";
+    session.ended_at = std::chrono::system_clock::now();
+    save(session);
+  }
+  return static_cast<int>(left.size());
+}
+
+StartOutcome Supervisor::start(const StartRequest& request) {
+  StartOutcome outcome;
+  Session* live = table_.by_uid(request.uid);
+  if (live != nullptr && live->state == SessionState::kEnding) {
+    outcome.kind = StartOutcome::Kind::kBusy;  // a few seconds from gone: the busy page retries
+    return outcome;
+  }
+  std::optional<SessionState> last;
+  if (live == nullptr) {
+    try {
+      if (const auto latest = index_.latest_for_uid(request.uid)) last = latest->state;
+    } catch (const std::exception& error) {
+      outcome.message = std::string("the session index cannot be read: ") + error.what();
+      return outcome;
+    }
+  }
+  switch (admit(live != nullptr, last, config_.allow_repeat, table_.full() || shutting_down_)) {
+    case Admission::kJoinLive:
+      outcome.kind = StartOutcome::Kind::kJoined;
+      outcome.token = live->token;
+      return outcome;
+    case Admission::kAlreadyCompleted:
+      outcome.kind = StartOutcome::Kind::kCompleted;
+      return outcome;
+    case Admission::kBusy:
+      outcome.kind = StartOutcome::Kind::kBusy;
+      return outcome;
+    case Admission::kStartNew:
+      break;
+  }
+
+  Session session;
+  session.uid = request.uid;
+  session.token = new_session_token();
+  session.scenario = request.scenario;
+  session.seed = request.seed.value_or(new_seed());
+  session.params_json = parameters_json(request, session.seed);
+  session.host_id = config_.host_id;
+  session.created = std::chrono::system_clock::now();
+  const auto started = SteadyClock::now();
+  // The row first: whatever happens next, the index knows this session existed.
+  try {
+    session.id = index_.insert(session);
+  } catch (const std::exception& error) {
+    outcome.message = std::string("the session index cannot be written: ") + error.what();
+    return outcome;
+  }
+
+  LaunchContext context;
+  context.seed = session.seed;
+  context.data_dir = (std::filesystem::absolute(config_.data_dir) / "sessions" /
+                      (std::to_string(session.id) + "-" + session.uid))
+                         .string();
+  session.data_path = context.data_dir;
+  SpawnedProcess process;
+  try {
+    std::filesystem::create_directories(context.data_dir);
+    if (config_.session_kind == SessionKind::kRfb) {
+      context.port = pick_free_port();
+      if (context.port == 0) throw std::runtime_error("no free loopback port");
+      session.port = context.port;
+    }
+    SpawnSpec spec;
+    spec.program = program_;
+    spec.args = session_arguments(config_, request, context);
+    spec.working_dir = context.data_dir;
+    spec.log_file = context.data_dir + "/session.log";
+    spec.ready_pipe = config_.session_kind == SessionKind::kSimRfb;
+    spec.limits.address_space_bytes = config_.limits.address_space_mb * 1024 * 1024;
+    spec.limits.open_files = config_.limits.open_files;
+    spec.limits.cpu_seconds = cpu_limit_seconds(config_);
+    process = spawn_session_process(spec);
+  } catch (const std::exception& error) {
+    session.state = SessionState::kFailed;
+    session.detail = error.what();
+    session.ended_at = std::chrono::system_clock::now();
+    save(session);
+    log_session(session, std::string("could not start: ") + error.what());
+    metrics_.count_rejection(Rejection::kStartFailed);
+    outcome.message = error.what();
+    return outcome;
+  }
+  session.pid = process.pid;
+  session.process_start = process.start_ticks;
+  save(session);
+  metrics_.count_start();
+  log_session(session, "started " + std::string(config_.session_kind == SessionKind::kSimRfb ? "sim_rfb" : "program") +
+                           " as pid " + std::to_string(process.pid) + " in " + session.data_path);
+
+  Session& kept = table_.add(std::move(session));
+  auto& rt = *runtimes_.emplace(kept.id, std::make_unique<Runtime>(io_)).first->second;
+  rt.started = started;
+  const std::int64_t id = kept.id;
+
+  rt.expiry.expires_after(config_.max_duration);
+  rt.expiry.async_wait([this, id](const boost::system::error_code& ec) {
+    Session* s = table_.by_id(id);
+    if (ec || s == nullptr) return;
+    begin_end(*s, SessionState::kExpired, "reached the maximum duration of " +
+                                              std::to_string(config_.max_duration.count()) + " s");
+  });
+  rt.start_deadline.expires_after(config_.start_timeout);
+  rt.start_deadline.async_wait([this, id](const boost::system::error_code& ec) {
+    Session* s = table_.by_id(id);
+    if (ec || s == nullptr || s->state != SessionState::kStarting) return;
+    begin_end(*s, SessionState::kFailed, "not ready after " + std::to_string(config_.start_timeout.count()) + " s");
+  });
+  arm_idle_timer(kept);
+  if (process.ready_fd >= 0) {
+    rt.ready_pipe.assign(process.ready_fd);
+    watch_ready_pipe(kept);
+  } else {
+    poll_rfb_port(id);
+  }
+  outcome.kind = StartOutcome::Kind::kStarted;
+  outcome.token = kept.token;
+  return outcome;
+}
+
+void Supervisor::watch_ready_pipe(Session& session) {
+  const std::int64_t id = session.id;
+  Runtime& rt = runtime(id);
+  rt.ready_pipe.async_read_some(asio::buffer(rt.buffer), [this, id](const boost::system::error_code& ec,
+                                                                    std::size_t bytes) {
+    Session* s = table_.by_id(id);
+    if (s == nullptr || s->state != SessionState::kStarting) return;
+    Runtime& r = runtime(id);
+    if (ec) return;  // closed without a line: the exit (or the start timeout) tells the rest
+    r.ready_text.append(r.buffer.data(), bytes);
+    const std::size_t newline = r.ready_text.find('\n');
+    if (newline == std::string::npos) {
+      if (r.ready_text.size() > 32) {
+        begin_end(*s, SessionState::kFailed, "the program's ready line is not 'ready PORT'");
+      } else {
+        watch_ready_pipe(*s);
+      }
+      return;
+    }
+    int port = 0;
+    char rest = 0;
+    if (std::sscanf(r.ready_text.substr(0, newline).c_str(), "ready %d%c", &port, &rest) != 1 || port < 1 ||
+        port > 65535) {
+      begin_end(*s, SessionState::kFailed, "the program's ready line is not 'ready PORT'");
+      return;
+    }
+    mark_ready(*s, port);
+  });
+}
+
+void Supervisor::poll_rfb_port(std::int64_t id) {
+  Session* session = table_.by_id(id);
+  if (session == nullptr || session->state != SessionState::kStarting) return;
+  Runtime& rt = runtime(id);
+  const asio::ip::tcp::endpoint endpoint(asio::ip::address_v4::loopback(), static_cast<unsigned short>(session->port));
+  rt.probe = asio::ip::tcp::socket(io_);
+  rt.probe.async_connect(endpoint, [this, id](const boost::system::error_code& ec) {
+    Session* s = table_.by_id(id);
+    if (s == nullptr || s->state != SessionState::kStarting) return;
+    Runtime& r = runtime(id);
+    boost::system::error_code ignored;
+    r.probe.close(ignored);
+    if (!ec) {
+      mark_ready(*s, s->port);
+      return;
+    }
+    r.poll.expires_after(kPortPollInterval);
+    r.poll.async_wait([this, id](const boost::system::error_code& wait_ec) {
+      if (!wait_ec) poll_rfb_port(id);
+    });
+  });
+}
+
+void Supervisor::mark_ready(Session& session, int port) {
+  Runtime& rt = runtime(session.id);
+  rt.start_deadline.cancel();
+  session.state = SessionState::kRunning;
+  session.port = port;
+  session.ready_at = std::chrono::system_clock::now();
+  save(session);
+  const double seconds = std::chrono::duration<double>(SteadyClock::now() - rt.started).count();
+  metrics_.observe_startup(seconds);
+  char text[96];
+  std::snprintf(text, sizeof text, "ready on port %d after %.3f s", port, seconds);
+  log_session(session, text);
+  if (listener_ != nullptr) listener_->session_ready(session);
+}
+
+void Supervisor::begin_end(Session& session, SessionState end_as, const std::string& detail) {
+  if (!begin_ending(session, end_as, detail)) return;
+  save(session);
+  log_session(session, std::string("ending (") + state_name(end_as) + "): " + detail);
+  if (listener_ != nullptr) listener_->session_closing(session);
+  Runtime& rt = runtime(session.id);
+  rt.start_deadline.cancel();
+  rt.expiry.cancel();
+  rt.idle.cancel();
+  if (config_.stop_grace.count() == 0) {
+    signal_process_group(session.pid, SIGKILL);
+    return;
+  }
+  signal_process_group(session.pid, SIGTERM);
+  const std::int64_t id = session.id;
+  rt.stop.expires_after(config_.stop_grace);
+  rt.stop.async_wait([this, id](const boost::system::error_code& ec) {
+    Session* s = table_.by_id(id);
+    if (ec || s == nullptr) return;
+    log_session(*s, "still running after the grace period; SIGKILL");
+    signal_process_group(s->pid, SIGKILL);
+  });
+}
+
+void Supervisor::reap_children() {
+  for (;;) {
+    // Look before reaping: while the exited leader is a zombie its id cannot be reused, so the SIGKILL to
+    // its group reaches only what the session's program left behind, never a stranger.
+    siginfo_t info{};
+    if (::waitid(P_ALL, 0, &info, WEXITED | WNOHANG | WNOWAIT) != 0 || info.si_pid == 0) return;
+    const pid_t pid = info.si_pid;
+    signal_process_group(pid, SIGKILL);
+    int status = 0;
+    if (::waitpid(pid, &status, 0) != pid) return;
+    if (Session* session = table_.by_pid(pid)) process_gone(*session, status);
+  }
+}
+
+std::string Supervisor::session_log_tail(const Session& session) const {
+  std::ifstream log(session.data_path + "/session.log", std::ios::binary | std::ios::ate);
+  if (!log) return "";
+  const std::streamoff size = log.tellg();
+  const std::streamoff from = size > 400 ? size - 400 : 0;
+  log.seekg(from);
+  std::string tail((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  while (!tail.empty() && (tail.back() == '\n' || tail.back() == '\r')) tail.pop_back();
+  const std::size_t newline = tail.rfind('\n');
+  return newline == std::string::npos ? tail : tail.substr(newline + 1);
+}
+
+void Supervisor::process_gone(Session& session, int wait_status) {
+  const SessionState final_state = state_after_exit(session, wait_status);
+  session.exit_status = describe_wait_status(wait_status);
+  if (session.state != SessionState::kEnding) {
+    const std::string last_line = session_log_tail(session);
+    session.detail = "the program stopped by itself (" + session.exit_status + ")" +
+                     (last_line.empty() ? "" : ": " + last_line);
+  }
+  session.state = final_state;
+  session.ended_at = std::chrono::system_clock::now();
+  save(session);
+  log_session(session, std::string(state_name(final_state)) + " (" + session.exit_status + ")");
+  if (listener_ != nullptr) listener_->session_closing(session);
+  const std::int64_t id = session.id;
+  runtimes_.erase(id);
+  table_.remove(id);  // the slot is free from here on
+  if (shutting_down_ && table_.size() == 0 && on_all_gone_) {
+    auto done = std::move(on_all_gone_);
+    on_all_gone_ = nullptr;
+    asio::post(io_, done);
+  }
+}
+
+void Supervisor::arm_idle_timer(Session& session) {
+  const std::int64_t id = session.id;
+  Runtime& rt = runtime(id);
+  rt.idle.expires_after(config_.idle_timeout);
+  rt.idle.async_wait([this, id](const boost::system::error_code& ec) {
+    Session* s = table_.by_id(id);
+    if (ec || s == nullptr || runtime(id).clients > 0) return;
+    begin_end(*s, SessionState::kIdle,
+              "no browser connected for " + std::to_string(config_.idle_timeout.count()) + " s");
+  });
+}
+
+void Supervisor::client_connected(std::int64_t id) {
+  Session* session = table_.by_id(id);
+  if (session == nullptr) return;
+  Runtime& rt = runtime(id);
+  ++rt.clients;
+  rt.idle.cancel();
+}
+
+void Supervisor::client_disconnected(std::int64_t id) {
+  Session* session = table_.by_id(id);
+  if (session == nullptr) return;
+  Runtime& rt = runtime(id);
+  if (rt.clients > 0) --rt.clients;
+  if (rt.clients == 0 && is_live(session->state) && session->state != SessionState::kEnding) {
+    arm_idle_timer(*session);
+  }
+}
+
+bool Supervisor::end_by_admin(std::int64_t id) {
+  Session* session = table_.by_id(id);
+  if (session == nullptr || session->state == SessionState::kEnding) return false;
+  begin_end(*session, SessionState::kEnded, "ended by an administrator");
+  return true;
+}
+
+void Supervisor::shutdown(std::function<void()> done) {
+  shutting_down_ = true;
+  on_all_gone_ = std::move(done);
+  for (Session* session : table_.all()) begin_end(*session, SessionState::kShutdown, "the manager stopped");
+  if (table_.size() == 0 && on_all_gone_) {
+    auto callback = std::move(on_all_gone_);
+    on_all_gone_ = nullptr;
+    asio::post(io_, callback);
+  }
+}
+
+std::optional<Session> Supervisor::find(const std::string& token) {
+  if (Session* live = table_.by_token(token)) return *live;
+  try {
+    return index_.find_by_token(token);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "[manager] cannot read the index: %s\n", error.what());
+    return std::nullopt;
+  }
+}
+
+std::map<SessionState, std::int64_t> Supervisor::counts_by_state() {
+  std::map<SessionState, std::int64_t> counts;
+  try {
+    for (const auto& [state, count] : index_.count_by_state()) {
+      if (!is_live(state)) counts[state] = count;
+    }
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "[manager] cannot read the index: %s\n", error.what());
+  }
+  for (Session* session : table_.all()) ++counts[session->state];
+  return counts;
+}
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The Supervisor runs the sessions' lives on the manager's one I/O thread: it starts processes, learns
+// when they are ready, ends them at expiry, idle timeout, an administrator's word or shutdown (SIGTERM,
+// then SIGKILL after the grace period), reaps them, and writes every change to the index before acting
+// on it. All its methods run on the I/O thread.
+#pragma once
+
+#include <boost/asio/io_context.hpp>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "config.hpp"
+#include "metrics.hpp"
+#include "session_index.hpp"
+#include "session_table.hpp"
+#include "start_request.hpp"
+
+namespace rfbsim::manager {
+
+/// What the frontend hears of sessions.
+class SessionListener {
+ public:
+  virtual ~SessionListener() = default;
+  /// The session is ready: its port takes connections.
+  virtual void session_ready(const Session& session) = 0;
+  /// The session is ending or gone (`session.state` says which, and `end_as` why): close its relays.
+  virtual void session_closing(const Session& session) = 0;
+};
+
+/// The outcome of a /start.
+struct StartOutcome {
+  enum class Kind { kJoined, kStarted, kBusy, kCompleted, kFailed } kind = Kind::kFailed;
+  std::string token;    ///< kJoined, kStarted
+  std::string message;  ///< kFailed: why, for the log and the page
+};
+
+class Supervisor {
+ public:
+  /// `program` is the resolved session program. Nothing starts until start() is called.
+  Supervisor(boost::asio::io_context& io, const ManagerConfig& config, std::string program, SessionIndex& index,
+             Metrics& metrics);
+  ~Supervisor();
+  Supervisor(const Supervisor&) = delete;
+  Supervisor& operator=(const Supervisor&) = delete;
+
+  void set_listener(SessionListener* listener) { listener_ = listener; }
+
+  /// After a restart: ends the processes of sessions the index says are live on this host (if they still
+  /// run) and marks those sessions interrupted. Returns how many there were.
+  int recover_interrupted();
+
+  /// Admits a valid link: back to the uid's live session, or a new one, or why not.
+  StartOutcome start(const StartRequest& request);
+
+  /// A browser connected to / disconnected from a session (the idle timer counts from the last one gone).
+  void client_connected(std::int64_t id);
+  void client_disconnected(std::int64_t id);
+
+  /// Ends a live session on an administrator's word; false if it is not live.
+  bool end_by_admin(std::int64_t id);
+
+  /// Ends every session and calls `done` once all processes are gone (SIGKILL after the grace period).
+  void shutdown(std::function<void()> done);
+
+  /// Live sessions.
+  SessionTable& table() { return table_; }
+  /// A session by token: live, else from the index.
+  std::optional<Session> find(const std::string& token);
+  /// The newest `limit` sessions from the index, newest first (throws std::runtime_error on index errors).
+  std::vector<Session> recent(int limit) { return index_.recent(limit); }
+  /// Sessions by state: live ones from the table, ended ones from the whole index.
+  std::map<SessionState, std::int64_t> counts_by_state();
+
+ private:
+  struct Runtime;
+
+  void begin_end(Session& session, SessionState end_as, const std::string& detail);
+  void watch_ready_pipe(Session& session);
+  void poll_rfb_port(std::int64_t id);
+  void mark_ready(Session& session, int port);
+  void reap_children();
+  void wait_for_children();
+  void process_gone(Session& session, int wait_status);
+  void arm_idle_timer(Session& session);
+  void save(const Session& session);
+  std::string session_log_tail(const Session& session) const;
+  Runtime& runtime(std::int64_t id);
+
+  boost::asio::io_context& io_;
+  const ManagerConfig& config_;
+  std::string program_;
+  SessionIndex& index_;
+  Metrics& metrics_;
+  SessionTable table_;
+  SessionListener* listener_ = nullptr;
+  std::map<std::int64_t, std::unique_ptr<Runtime>> runtimes_;
+  struct ChildWatch;
+  std::unique_ptr<ChildWatch> child_watch_;
+  std::function<void()> on_all_gone_;  // set by shutdown()
+  bool shutting_down_ = false;
+};
+
+}  // namespace rfbsim::manager
