@@ -157,6 +157,11 @@ const std::map<std::string, Setting>& settings() {
          return "";
        }}},
       {"web_root", {false, text(&ManagerConfig::web_root)}},
+      {"public_url", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (!is_origin(v.front())) return "expected an origin such as https://h1.study.example.org (no path)";
+         c.public_url = v.front();
+         return "";
+       }}},
       {"limit_address_space_mb", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          if (!parse_integer<std::uint64_t>(v.front(), 0, 1ULL << 30, c.limits.address_space_mb)) {
            return "expected MiB, 0 = no limit";
@@ -221,6 +226,7 @@ std::string manager_usage() {
          "                   [--session-arg ARG]... [--max-sessions N] [--max-duration-s S] [--idle-timeout-s S]\n"
          "                   [--data-dir DIR] [--scenarios A,B] [--frame-origins O1,O2] [--admin-token T]\n"
          "                   [--link-secret S] [--allow-repeat true|false] [--host-id ID] [--web-root DIR]\n"
+         "                   [--public-url ORIGIN]\n"
          "       sim_manager [--config FILE] --sign 'uid=...&scenario=...'\n"
          "Every flag is also a key of the YAML config file (--max-sessions N is max_sessions: N).\n"
          "  --listen-address ADDR   numeric IPv4 address (default 127.0.0.1)\n"
@@ -243,6 +249,7 @@ std::string manager_usage() {
          "  --allow-repeat B        a uid whose session ended may start another (default false)\n"
          "  --host-id ID            this host's name in the index (default: the host name)\n"
          "  --web-root DIR          the participant page (default: the built or installed one)\n"
+         "  --public-url ORIGIN     this host's public origin; /start redirects there (several hosts)\n"
          "  --limit-address-space-mb N, --limit-open-files N, --limit-cpu-time-factor F, --limit-cpu-slack-s S\n"
          "                          per-session resource limits (0 = none)\n"
          "  --sign QUERY            print QUERY with its link signature (needs a link secret) and exit\n";
@@ -267,7 +274,11 @@ ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
     return outcome;
   }
   for (const auto& item : root) {
-    const std::string key = item.first.as<std::string>();
+    if (!item.first.IsScalar()) {
+      outcome.error = path + ":" + std::to_string(item.first.Mark().line + 1) + ": expected a setting name as key";
+      return outcome;
+    }
+    const std::string key = item.first.Scalar();
     const std::string where = path + ":" + std::to_string(item.first.Mark().line + 1) + ": " + key + ": ";
     const auto setting = settings().find(key);
     if (setting == settings().end()) {
@@ -351,7 +362,9 @@ ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
         setting->second.list ? split_commas(value) : std::vector<std::string>{value};
     const std::string problem = setting->second.apply(outcome.config, values);
     if (!problem.empty()) {
-      outcome.error = flag + " '" + value + "': " + problem;
+      // Secrets are never echoed: error messages end up in logs and terminals.
+      const bool secret = setting->first == "admin_token" || setting->first == "link_secret";
+      outcome.error = flag + (secret ? "" : " '" + value + "'") + ": " + problem;
       return outcome;
     }
   }

@@ -49,6 +49,9 @@ struct ManagerConfig {
   bool allow_repeat = false;                 ///< a uid whose session ended may start another
   std::string host_id;                       ///< recorded in the index; empty = this machine's host name
   std::string web_root;                      ///< participant page; empty = the built or installed one
+  /// This host's own public origin (e.g. https://h2.study.example.org); when set, /start redirects there,
+  /// so that a load balancer can hand new links to any host and the session stays with its host.
+  std::string public_url;
   ProcessLimits limits;
 };
 

@@ -241,7 +241,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
     switch (outcome.kind) {
       case StartOutcome::Kind::kJoined:
       case StartOutcome::Kind::kStarted: {
-        const std::string location = "/s/" + outcome.token + "/";
+        const std::string location = config_.public_url + "/s/" + outcome.token + "/";
         respond_page(con, 302, "<!DOCTYPE html><title>Starting</title><a href=\"" + location + "\">Continue</a>\n",
                      {{"Location", location}});
         return;

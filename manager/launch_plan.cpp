@@ -11,10 +11,21 @@ namespace rfbsim::manager {
 
 namespace {
 
-void replace_all(std::string& text, const std::string& from, const std::string& to) {
-  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
-    text.replace(at, from.size(), to);
+// Replaces every placeholder of `values` in one pass over `text`: a value put in is never searched again
+// (a scenario file "/srv/{uid}.yaml" stays as it is).
+std::string expand(const std::string& text, const std::vector<std::pair<std::string, std::string>>& values) {
+  std::string out;
+  for (std::size_t at = 0; at < text.size();) {
+    const auto match = std::find_if(values.begin(), values.end(),
+                                    [&](const auto& value) { return text.compare(at, value.first.size(), value.first) == 0; });
+    if (match == values.end()) {
+      out.push_back(text[at++]);
+    } else {
+      out += match->second;
+      at += match->first.size();
+    }
   }
+  return out;
 }
 
 }  // namespace
@@ -23,14 +34,13 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
                                            const LaunchContext& context) {
   const std::string scenario = scenario_argument(config.scenarios, request.scenario);
   if (config.session_kind == SessionKind::kRfb) {
-    std::vector<std::string> args = config.session_args;
-    for (std::string& arg : args) {
-      replace_all(arg, "{port}", std::to_string(context.port));
-      replace_all(arg, "{scenario}", scenario);
-      replace_all(arg, "{seed}", std::to_string(context.seed));
-      replace_all(arg, "{uid}", request.uid);
-      replace_all(arg, "{data_dir}", context.data_dir);
-    }
+    const std::vector<std::pair<std::string, std::string>> values = {{"{port}", std::to_string(context.port)},
+                                                                      {"{scenario}", scenario},
+                                                                      {"{seed}", std::to_string(context.seed)},
+                                                                      {"{uid}", request.uid},
+                                                                      {"{data_dir}", context.data_dir}};
+    std::vector<std::string> args;
+    for (const std::string& arg : config.session_args) args.push_back(expand(arg, values));
     return args;
   }
   std::vector<std::string> args = {"--port",   "0",

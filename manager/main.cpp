@@ -8,6 +8,7 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -104,12 +105,17 @@ int run(ManagerConfig config) {
   const auto frontend = manager::make_frontend(io, config, supervisor, metrics, web_root);
 
   // SIGINT / SIGTERM: stop taking connections, end every session, then leave.
+  // The close frames sent to browsers get a moment to leave before the I/O loop stops.
   boost::asio::signal_set stop_signals(io, SIGINT, SIGTERM);
+  boost::asio::steady_timer last_words(io);
   stop_signals.async_wait([&](const boost::system::error_code& ec, int signal) {
     if (ec) return;
     std::fprintf(stderr, "[manager] signal %d: ending %zu session(s)\n", signal, supervisor.table().size());
     frontend->stop();
-    supervisor.shutdown([&io] { io.stop(); });
+    supervisor.shutdown([&] {
+      last_words.expires_after(std::chrono::milliseconds(200));
+      last_words.async_wait([&io](const boost::system::error_code&) { io.stop(); });
+    });
   });
 
   const std::string host = config.listen_address == "0.0.0.0" ? "127.0.0.1" : config.listen_address;

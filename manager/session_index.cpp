@@ -132,8 +132,12 @@ std::optional<WallTime> parse_iso_utc(const std::string& text) {
   parts.tm_year -= 1900;
   parts.tm_mon -= 1;
   const std::time_t seconds = timegm(&parts);
-  return WallTime(std::chrono::duration_cast<WallTime::duration>(std::chrono::seconds(seconds) +
-                                                                 std::chrono::milliseconds(millis)));
+  const WallTime time(std::chrono::duration_cast<WallTime::duration>(std::chrono::seconds(seconds) +
+                                                                     std::chrono::milliseconds(millis)));
+  // sscanf takes trailing text, short or signed fields and out-of-range dates (which timegm normalizes):
+  // only text that iso_utc writes back the same is ours.
+  if (iso_utc(time) != text) return std::nullopt;
+  return time;
 }
 
 SessionIndex::SessionIndex(const std::string& path) : path_(path) {

@@ -14,6 +14,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -157,7 +158,9 @@ SpawnedProcess spawn_session_process(const SpawnSpec& spec) {
   if (got == static_cast<ssize_t>(sizeof code)) {
     int status = 0;
     ::waitpid(pid, &status, 0);
-    throw std::runtime_error(std::string("cannot ") + stage_name(code[0]) + " " + spec.program + ": " +
+    // Name what failed: the folder when the child could not enter it, else the program.
+    const std::string& subject = code[0] == 4 ? spec.working_dir : spec.program;
+    throw std::runtime_error(std::string("cannot ") + stage_name(code[0]) + " " + subject + ": " +
                              std::strerror(code[1]));
   }
 
@@ -178,7 +181,25 @@ bool signal_process_group(pid_t pgid, int signal) {
 
 bool process_group_alive(pid_t pgid) {
   if (pgid <= 1) return false;
-  return ::kill(-pgid, 0) == 0 || errno == EPERM;
+  if (::kill(-pgid, 0) != 0 && errno != EPERM) return false;
+  // The group exists, but zombies count too: a dead session whose new parent (init, after the manager
+  // died) has not reaped it yet is gone for our purposes. Look for a member that still runs.
+  std::error_code ec;
+  for (auto it = std::filesystem::directory_iterator("/proc", ec); !ec && it != std::filesystem::directory_iterator();
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream stat(it->path() / "stat");
+    std::string text;
+    if (!std::getline(stat, text)) continue;
+    const std::size_t close = text.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream fields(text.substr(close + 2));
+    std::string state;
+    long parent = 0, group = 0;
+    if (fields >> state >> parent >> group && group == pgid && state != "Z" && state != "X") return true;
+  }
+  return false;
 }
 
 std::optional<std::int64_t> process_start_ticks(pid_t pid) {

@@ -52,7 +52,7 @@ bool signal_process_group(pid_t pgid, int signal);
 /// does not exist.
 std::optional<std::int64_t> process_start_ticks(pid_t pid);
 
-/// Whether a process group still has members.
+/// Whether a process group still has a member that runs (zombies waiting to be reaped do not count).
 bool process_group_alive(pid_t pgid);
 
 }  // namespace rfbsim::manager

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
-# Sets everything up and starts the demo: sim_rfb in the warehouse scenario, printing the link to open.
-#   scripts/run-demo.sh [sim_rfb options, e.g. --port 5901 --bind 0.0.0.0 --scenario lab]
+# Sets everything up and starts the demo: sim_manager on http://127.0.0.1:8080/ with the shipped scenarios,
+# printing a participant link to open. Each link (uid) gets its own sim_rfb session.
+#   scripts/run-demo.sh [sim_manager options, e.g. --port 9000 --listen-address 0.0.0.0 --max-sessions 2]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-exec build/simulator/sim_rfb --scenario warehouse "$@"
+# The demo lets a link be opened again after its session ended; a study leaves allow_repeat off.
+exec build/manager/sim_manager --scenarios warehouse,lab --allow-repeat true --data-dir build/demo-data "$@"

@@ -9,6 +9,8 @@ import RFB from './novnc/core/rfb.js';
 const ui = {
   screen: document.getElementById('screen'),
   status: document.getElementById('status'),
+  statusText: document.getElementById('status-text'),
+  statusTimer: document.getElementById('status-timer'),
   hint: document.getElementById('hint'),
   panel: document.getElementById('disconnected'),
   panelTitle: document.getElementById('disconnected-title'),
@@ -26,13 +28,18 @@ const state = {
   attempts: 0,            // connection attempts made by this page (1 = the first, no reconnects yet)
   focused: false,         // keyboard focus is on the simulator view (keys reach the simulator)
   desktopName: '',        // name the server gave its desktop
-  lastDisconnect: null,   // { kind: 'ended' | 'lost' | 'failed', clean, code, wasClean, reason, message }
+  lastDisconnect: null,   // { kind: 'ended' | 'lost' | 'failed', final, clean, code, wasClean, reason,
+                          //   sessionState, message }; final: the manager says the session is over for good
   options: null,          // { quality, compression } taken from the query string (null where absent or invalid)
+  firstFrameAt: null,     // ms since the navigation started (performance.now()) when a picture was first drawn
+  sessionState: null,     // the manager's last word on this session ('starting', 'running', 'ended', ...), or
+                          // null where no manager answers (sim_rfb serving the page itself)
 };
 window.rfbsimState = state;
 
-let rfb = null;       // the current noVNC client, or null while disconnected
-let canvas = null;    // that client's canvas (noVNC makes a new one for every client)
+let rfb = null;           // the current noVNC client, or null while disconnected
+let canvas = null;        // that client's canvas (noVNC makes a new one for every client)
+let pictureShown = false; // the current client has drawn its first picture
 
 // ---------------------------------------------------------------------------------------------------------------
 // Options from the query string: ?quality=0..9&compression=0..9. Anything else is ignored with a warning.
@@ -57,22 +64,141 @@ const options = {
 };
 state.options = options;
 
-// The simulator serves this page and its WebSocket on one port: 'websockify' next to the page, ws: or wss: to
-// match http: or https:. For a page at '/' that is '/websockify'.
+// ---------------------------------------------------------------------------------------------------------------
+// Addresses, relative to this page so that they work both under sim_manager (/s/<token>/) and from sim_rfb
+// itself (/, where any WebSocket path is accepted and 'status' does not exist).
+// ---------------------------------------------------------------------------------------------------------------
+
+// The WebSocket next to the page: ws: or wss: to match http: or https:.
 function websocketUrl() {
-  const url = new URL('websockify', window.location.href);
+  const url = new URL('ws', window.location.href);
   url.protocol = window.location.protocol === 'https:' ? 'wss:' : 'ws:';
   url.search = '';
   url.hash = '';
   return url.href;
 }
 
+const statusUrl = new URL('status', window.location.href);
+statusUrl.search = '';
+statusUrl.hash = '';
+
+// ---------------------------------------------------------------------------------------------------------------
+// The manager's view of this session: GET status -> {"state": "starting" | "running" | "ending" | <final>,
+// "ends_as": <the state it ends in>, "elapsed_s": seconds since the link was opened}.
+// ---------------------------------------------------------------------------------------------------------------
+const STATUS_POLL_MS = 250;       // while no picture shows, the status is asked for this often
+const STATUS_TIMEOUT_MS = 2000;   // one status request may take this long
+const LIVE_STATES = new Set(['starting', 'running']);
+
+// Why a session is over, in words, by the state it ended in (the manager's `ends_as`).
+const SESSION_OVER_WORDS = {
+  finished: 'The session is complete.',
+  expired: 'The session reached its time limit.',
+  idle: 'The session ended because no one was connected to it for a while.',
+  ended: 'The session was ended by the researcher.',
+  shutdown: 'The session ended because the server was shut down.',
+  crashed: 'The simulator stopped unexpectedly.',
+  failed: 'The simulator could not start.',
+  interrupted: 'The session was interrupted.',
+};
+// Sessions that did not run their course: the study link starts a new one.
+const RESTARTABLE_STATES = new Set(['shutdown', 'crashed', 'failed', 'interrupted']);
+
+let statusAvailable = true;  // false once 'status' answered like no manager is there (sim_rfb's 404)
+let statusPolling = false;   // the polling loop runs
+let startingSince = null;    // { elapsedS, at }: the session's start-up time as last reported, and when
+
+function timeoutSignal(ms) {
+  return typeof AbortSignal.timeout === 'function' ? AbortSignal.timeout(ms) : undefined;
+}
+
+// Asks for the session's status. Resolves with { state, endsAs, elapsedS }, or null when there is no answer to
+// use (no manager, or the request failed; a failure is tried again by the next poll).
+async function fetchSessionStatus() {
+  if (!statusAvailable) {
+    return null;
+  }
+  let response;
+  let body = null;
+  try {
+    response = await fetch(statusUrl, { cache: 'no-store', signal: timeoutSignal(STATUS_TIMEOUT_MS) });
+    const type = response.headers.get('Content-Type') || '';
+    if (type.includes('json')) {
+      body = await response.json();
+    }
+  } catch (err) {
+    return null;   // network trouble or a body that is not JSON after all: ask again later
+  }
+  const valid = response.ok && body !== null && typeof body === 'object' && typeof body.state === 'string';
+  if (!valid) {
+    // sim_rfb serving the page itself answers 404 (text); a manager answers JSON. Give up on anything else too,
+    // except server errors, which may pass.
+    if (response.status < 500) {
+      statusAvailable = false;
+    }
+    return null;
+  }
+  const status = {
+    state: body.state,
+    endsAs: typeof body.ends_as === 'string' ? body.ends_as : body.state,
+    elapsedS: Number.isFinite(body.elapsed_s) ? body.elapsed_s : null,
+  };
+  state.sessionState = status.state;
+  startingSince = status.state === 'starting' && status.elapsedS !== null
+    ? { elapsedS: status.elapsedS, at: performance.now() } : null;
+  return status;
+}
+
+// Polls the status while a connection is being made or its first picture is awaited, updating the progress line;
+// once the picture shows, asks once more so that rfbsimState.sessionState is current.
+function startStatusPolling() {
+  if (statusPolling) {
+    return;
+  }
+  statusPolling = true;
+  (async () => {
+    while (statusAvailable && (state.connecting || state.connected) && !pictureShown) {
+      await fetchSessionStatus();
+      showProgress();
+      await new Promise((resolve) => setTimeout(resolve, STATUS_POLL_MS));
+    }
+    if (pictureShown) {
+      await fetchSessionStatus();
+    }
+    statusPolling = false;
+  })();
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // What the page shows.
 // ---------------------------------------------------------------------------------------------------------------
-function showStatus(text) {
-  ui.status.textContent = text;
+
+// The progress line; `counter` (e.g. "3 s") is shown but not announced, and text is only set when it changes,
+// so that screen readers hear each phase once.
+function showStatus(text, counter = '') {
+  if (ui.statusText.textContent !== text) {
+    ui.statusText.textContent = text;
+  }
+  if (ui.statusTimer.textContent !== counter) {
+    ui.statusTimer.textContent = counter;
+  }
   ui.status.hidden = text === '';
+}
+
+// The progress line for where the current attempt stands: starting (with the manager's clock), connecting,
+// loading the first picture, or nothing once the picture shows.
+function showProgress() {
+  if (state.connected) {
+    showStatus(pictureShown ? '' : 'Loading the picture\u2026');
+  } else if (state.connecting) {
+    if (state.sessionState === 'starting' && startingSince !== null) {
+      const seconds = startingSince.elapsedS + (performance.now() - startingSince.at) / 1000;
+      showStatus('Starting your simulation\u2026', `${Math.floor(seconds)} s`);
+    } else {
+      const again = state.attempts > 1;
+      showStatus(again ? 'Reconnecting to the simulator\u2026' : 'Connecting to the simulator\u2026');
+    }
+  }
 }
 
 // The hint shows while a session is up and keys would not reach it (focus elsewhere, or the window/iframe
@@ -82,19 +208,64 @@ function updateFocus() {
   ui.hint.hidden = !state.connected || state.focused;
 }
 
-function showDisconnected(title, message) {
+// The panel after a disconnect. `final`: the session is over for good, so there is nothing to reconnect to.
+function showDisconnected(title, message, final) {
   ui.panelTitle.textContent = title;
   ui.panelDetail.textContent = message;
+  ui.reconnect.hidden = final;
+  ui.reconnect.disabled = final;
   ui.panel.hidden = false;
-  ui.reconnect.disabled = false;
   // Only when this page already has the keyboard: never pull focus away from a survey around the iframe.
   if (document.hasFocus()) {
-    ui.reconnect.focus({ preventScroll: true });
+    (final ? ui.panel : ui.reconnect).focus({ preventScroll: true });
   }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
+// The first picture. noVNC draws into its canvas only when a whole framebuffer update is in, and until then the
+// canvas is transparent (it is cleared whenever noVNC sizes it): the first opaque pixel is the first picture.
+// Looked for once per animation frame in an 8x8 copy, so noVNC's own canvas is never read back (a canvas read
+// from often is moved off the GPU). Hidden pages get no animation frames: a picture counts once it can be seen.
+// ---------------------------------------------------------------------------------------------------------------
+const PROBE_SIZE = 8;
+
+function watchForFirstPicture(client, view) {
+  const probe = document.createElement('canvas');
+  probe.width = PROBE_SIZE;
+  probe.height = PROBE_SIZE;
+  const probeContext = probe.getContext('2d', { willReadFrequently: true });
+  const look = () => {
+    if (rfb !== client) {
+      return;   // that attempt is over
+    }
+    if (view.width > 0 && view.height > 0) {
+      probeContext.clearRect(0, 0, PROBE_SIZE, PROBE_SIZE);
+      probeContext.drawImage(view, 0, 0, PROBE_SIZE, PROBE_SIZE);
+      const pixels = probeContext.getImageData(0, 0, PROBE_SIZE, PROBE_SIZE).data;
+      for (let i = 3; i < pixels.length; i += 4) {
+        if (pixels[i] !== 0) {
+          firstPictureShown();
+          return;
+        }
+      }
+    }
+    window.requestAnimationFrame(look);
+  };
+  window.requestAnimationFrame(look);
+}
+
+function firstPictureShown() {
+  pictureShown = true;
+  if (state.firstFrameAt === null) {
+    state.firstFrameAt = performance.now();
+  }
+  showProgress();
+}
+
+// ---------------------------------------------------------------------------------------------------------------
 // One connection attempt. noVNC clients cannot be reused after 'disconnect', so every attempt makes a new one.
+// The socket is opened at once: under sim_manager it is held until the session is ready, so the first frame
+// comes as early as it can; the status is polled meanwhile to show the start-up progress.
 // ---------------------------------------------------------------------------------------------------------------
 function connect({ focusWhenConnected = false } = {}) {
   if (state.connecting || state.connected) {
@@ -102,8 +273,9 @@ function connect({ focusWhenConnected = false } = {}) {
   }
   state.attempts += 1;
   state.connecting = true;
+  pictureShown = false;
   ui.panel.hidden = true;
-  showStatus(state.attempts === 1 ? 'Connecting to the simulator\u2026' : 'Reconnecting to the simulator\u2026');
+  showProgress();
   updateFocus();
 
   // Open the WebSocket ourselves so that the close code is known when noVNC reports the disconnect.
@@ -130,6 +302,7 @@ function connect({ focusWhenConnected = false } = {}) {
     return;
   }
   rfb = client;
+  startStatusPolling();
 
   // View: scaled to the window and letterboxed; the session keeps its own size.
   client.scaleViewport = true;
@@ -145,7 +318,7 @@ function connect({ focusWhenConnected = false } = {}) {
     client.compressionLevel = options.compression;
   }
 
-  // The canvas: reachable with Tab, announced to screen readers, and watched for focus.
+  // The canvas: reachable with Tab, announced to screen readers, and watched for focus and the first picture.
   canvas = ui.screen.querySelector('canvas');
   if (canvas !== null) {
     canvas.tabIndex = 0;
@@ -153,6 +326,7 @@ function connect({ focusWhenConnected = false } = {}) {
     canvas.setAttribute('aria-label', 'Simulator view. Use W, A, S and D to walk.');
     canvas.addEventListener('focus', updateFocus);
     canvas.addEventListener('blur', updateFocus);
+    watchForFirstPicture(client, canvas);
   }
 
   let securityReason = '';
@@ -163,7 +337,7 @@ function connect({ focusWhenConnected = false } = {}) {
     state.connecting = false;
     state.connected = true;
     state.everConnected = true;
-    showStatus('');
+    showProgress();
     if (focusWhenConnected) {
       client.focus({ preventScroll: true });
     }
@@ -200,8 +374,9 @@ function connect({ focusWhenConnected = false } = {}) {
   });
 }
 
-// Called once per attempt when it is over: forget the client and say what happened.
-function finishAttempt(info) {
+// Called once per attempt when it is over: forget the client, ask the manager (if any) whether the session is
+// over for good, and say what happened.
+async function finishAttempt(info) {
   if (canvas !== null) {
     canvas.removeEventListener('focus', updateFocus);
     canvas.removeEventListener('blur', updateFocus);
@@ -212,6 +387,18 @@ function finishAttempt(info) {
   state.connected = false;
   showStatus('');
   updateFocus();
+
+  // Over for good when the manager says the session is neither starting nor running: a reconnect cannot help.
+  const session = await fetchSessionStatus();
+  if (session !== null && !LIVE_STATES.has(session.state)) {
+    let message = SESSION_OVER_WORDS[session.endsAs] || `The session is over (${session.endsAs}).`;
+    if (RESTARTABLE_STATES.has(session.endsAs)) {
+      message += ' Opening your study link again starts a new session.';
+    }
+    state.lastDisconnect = { ...info, kind: 'ended', final: true, sessionState: session.state, message };
+    showDisconnected('Session ended', message, true);
+    return;
+  }
 
   let title;
   let message;
@@ -233,8 +420,8 @@ function finishAttempt(info) {
     message += ` (${info.reason})`;
   }
   message += ' Press Reconnect to try again.';
-  state.lastDisconnect = { ...info, message };
-  showDisconnected(title, message);
+  state.lastDisconnect = { ...info, final: false, sessionState: session ? session.state : null, message };
+  showDisconnected(title, message, false);
 }
 
 // ---------------------------------------------------------------------------------------------------------------

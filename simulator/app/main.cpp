@@ -189,6 +189,18 @@ int run(const rfbsim::sim::SimOptions& options) {
   scene_style.debug_overlay = options.debug_overlay;
   std::uint64_t frames_rendered = 0;
   std::optional<sim::Scene> last_drawn;  // the server keeps showing it; an equal scene is not drawn again
+  // Draws the world and hands the frame to the server, unless it would look the same as the last one.
+  const auto draw_if_changed = [&] {
+    sim::Scene scene = sim::build_scene(simulation.world(), scene_style);
+    if (last_drawn && sim::same_scene(scene, *last_drawn)) return;
+    gl.begin_frame();
+    renderer.draw(scene, gl.width(), gl.height());
+    server.submit(gl.read_frame());
+    ++frames_rendered;
+    last_drawn = std::move(scene);
+  };
+  // One frame before anyone watches, so that the first update a viewer gets is the scene, not black.
+  draw_if_changed();
 
   // Readers of /status.json never see an empty document, even before the first tick.
   status.publish(sim::status_json(simulation.world(), 0, 0));
@@ -221,14 +233,7 @@ int run(const rfbsim::sim::SimOptions& options) {
     if (clients == 0) {
       next_frame = now;
     } else if (now >= next_frame) {
-      sim::Scene scene = sim::build_scene(simulation.world(), scene_style);
-      if (!last_drawn || !sim::same_scene(scene, *last_drawn)) {
-        gl.begin_frame();
-        renderer.draw(scene, gl.width(), gl.height());
-        server.submit(gl.read_frame());
-        ++frames_rendered;
-        last_drawn = std::move(scene);
-      }
+      draw_if_changed();
       next_frame += frame_interval;
       if (next_frame < now) next_frame = now + frame_interval;  // fell behind: skip, do not burst
     }

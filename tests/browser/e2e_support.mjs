@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Shared parts of the browser end-to-end tests (e2e_walk.mjs, e2e_scenes.mjs): progress and failure, sim_rfb
-// processes, a headless Chromium on the participant page, canvas pixels, and cleanup whatever happens.
+// Shared parts of the browser end-to-end tests (e2e_walk.mjs, e2e_scenes.mjs, e2e_robot.mjs, e2e_manager.mjs):
+// progress and failure, sim_rfb (or sim_manager) processes, a headless Chromium on the participant page, canvas
+// pixels, and cleanup whatever happens.
 //
-// Every test script takes the same arguments (SIM_RFB ARTIFACTS_DIR [WEB_DIR], see parseArgs) and ends through
-// runTest, which always stops what was started and exits 0 (passed), 1 (a check failed) or 2 (overall timeout).
+// The sim_rfb tests take the same arguments (SIM_RFB ARTIFACTS_DIR [WEB_DIR], see parseArgs); e2e_manager.mjs
+// reads its own. Every test ends through runTest, which always stops what was started and exits 0 (passed),
+// 1 (a check failed) or 2 (overall timeout).
 
 import { spawn } from 'node:child_process';
 import fs from 'node:fs';
@@ -250,14 +252,16 @@ let userDataDir = null;
 const consoleLogs = [];   // every log stream recordPage opened, for cleanup
 
 // Launches headless Chromium with a window of viewport { width, height } and resolves with its context.
+// contextOptions: more of playwright's launchPersistentContext options (httpCredentials, say).
 // Once per test: cleanup knows one browser, so a second call throws rather than leak the first and its profile.
-export async function launchBrowser(chromium, viewport) {
+export async function launchBrowser(chromium, viewport, contextOptions = {}) {
   if (userDataDir !== null) {
     throw new Error('launchBrowser called a second time: a test has one browser; use the context it returned');
   }
   userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'rfbsim-e2e-chromium-'));
   log(`launching ${CHROMIUM}`);
   context = await chromium.launchPersistentContext(userDataDir, {
+    ...contextOptions,
     executablePath: CHROMIUM,
     headless: true,
     args: CHROMIUM_ARGS,
@@ -414,6 +418,13 @@ export async function waitForPicture(page, name) {
 // Running a test: overall timeout, interruption, and cleanup always, once, whatever happened.
 // ---------------------------------------------------------------------------------------------------------------
 let cleanupPromise = null;
+const cleanupHooks = [];   // onCleanup's functions
+
+// Adds fn (sync or async) to what cleanup does once the browser is closed and the started processes are stopped:
+// a test's own servers, or processes its processes started. Errors in fn are logged and otherwise ignored.
+export function onCleanup(fn) {
+  cleanupHooks.push(fn);
+}
 
 function cleanup() {
   if (cleanupPromise) {
@@ -437,6 +448,13 @@ function cleanup() {
       // The sim's last lines may still be in its pipes after 'exit': read them into the log before it ends.
       await Promise.race([sim.closedPromise, sleep(STREAM_END_TIMEOUT_MS)]);
       logsWritten.push(endStream(sim.logFile));
+    }
+    for (const hook of cleanupHooks) {
+      try {
+        await hook();
+      } catch (err) {
+        log(`cleanup: ${err && err.message ? err.message : err}`);
+      }
     }
     await Promise.all(logsWritten);
     if (userDataDir) {

@@ -167,9 +167,10 @@ class ManagedSim {
 TEST_CASE("holding W walks the avatar and changes the picture") {
   SimProcess sim(rfbsim::test::sim_rfb_path(), kSmall);
   std::string status;
-  // Nobody watches yet: the simulation ticks but renders nothing.
+  // Nobody watches yet: the simulation ticks but renders nothing beyond the one frame drawn before it
+  // reported ready (so that a viewer's first update is already the scene).
   REQUIRE(await_status(sim, nullptr, [](const std::string& s) { return json_number(s, "tick") > 10; }, status));
-  CHECK(json_number(status, "frames_rendered") == 0);
+  CHECK(json_number(status, "frames_rendered") == 1);
   const double y0 = json_number(status, "y");
 
   auto client = std::make_unique<RfbTestClient>("127.0.0.1", sim.port());

@@ -89,7 +89,7 @@ SimProcess::SimProcess(const std::string& program, const std::vector<std::string
 
   // Read stdout until the ready line names the URL.
   std::string output;
-  const std::regex ready(R"(ready: (http://[^:/\s]+:(\d+)/))");
+  const std::regex ready(R"(ready: (https?://[^:/\s]+:(\d+)/))");
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   std::smatch match;
   while (!std::regex_search(output, match, ready)) {

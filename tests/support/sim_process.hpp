@@ -12,7 +12,7 @@ namespace rfbsim::test {
 
 class SimProcess {
  public:
-  /// Starts `program` with `args` (no shell), and waits for its "ready: URL" line on stdout.
+  /// Starts `program` with `args` (no shell), and waits for its "ready: URL" line (http or https) on stdout.
   /// Throws std::runtime_error if it exits or stays silent past `timeout`.
   SimProcess(const std::string& program, const std::vector<std::string>& args,
              std::chrono::milliseconds timeout = std::chrono::seconds(30));

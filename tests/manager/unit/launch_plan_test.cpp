@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+#include <catch2/catch.hpp>
+
+#include "launch_plan.hpp"
+
+using rfbsim::manager::LaunchContext;
+using rfbsim::manager::ManagerConfig;
+using rfbsim::manager::parameters_json;
+using rfbsim::manager::session_arguments;
+using rfbsim::manager::SessionKind;
+using rfbsim::manager::StartRequest;
+
+using Args = std::vector<std::string>;
+
+namespace {
+
+StartRequest request(const std::string& scenario) {
+  StartRequest r;
+  r.uid = "p01";
+  r.scenario = scenario;
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("sim_rfb gets its fixed flags, the scenario and the seed") {
+  ManagerConfig config;
+  const LaunchContext context{7, 0, "/data/p01-1"};
+  CHECK(session_arguments(config, request("lab"), context) ==
+        Args{"--port", "0", "--bind", "127.0.0.1", "--rfb-only", "--ready-fd", "3", "--scenario", "lab", "--seed", "7"});
+}
+
+TEST_CASE("sim_rfb gets one flag per override, then the configured extra arguments") {
+  ManagerConfig config;
+  config.scenarios = {"warehouse", "lab=/srv/scenarios/lab.yaml"};
+  config.session_args = {"--width", "1280", "--fps=30"};
+  StartRequest r = request("lab");
+  r.overrides = {{"avatar_start", "1.5,-2,0.25"}, {"robot_goal", "dock"}, {"crowd", "12"}};
+  const LaunchContext context{18446744073709551615ULL, 0, "/data/p01-1"};
+  CHECK(session_arguments(config, r, context) == Args{"--port",
+                                                       "0",
+                                                       "--bind",
+                                                       "127.0.0.1",
+                                                       "--rfb-only",
+                                                       "--ready-fd",
+                                                       "3",
+                                                       "--scenario",
+                                                       "/srv/scenarios/lab.yaml",
+                                                       "--seed",
+                                                       "18446744073709551615",
+                                                       "--avatar-start",
+                                                       "1.5,-2,0.25",
+                                                       "--robot-goal",
+                                                       "dock",
+                                                       "--crowd",
+                                                       "12",
+                                                       "--width",
+                                                       "1280",
+                                                       "--fps=30"});
+}
+
+TEST_CASE("an rfb program gets its argument template with the placeholders replaced") {
+  ManagerConfig config;
+  config.session_kind = SessionKind::kRfb;
+  config.scenarios = {"warehouse=/srv/w.yaml", "lab"};
+  config.session_args = {"--listen=127.0.0.1:{port}", "{port}", "--log", "{data_dir}/{uid}-{seed}.log",
+                         "--scenario", "{scenario}", "{port}{port}", "{unknown}", "plain"};
+  StartRequest r = request("warehouse");
+  r.overrides = {{"crowd", "3"}};  // overrides are sim_rfb's; an rfb program's template is all it gets
+  const LaunchContext context{42, 5907, "/data/p01-3"};
+  CHECK(session_arguments(config, r, context) == Args{"--listen=127.0.0.1:5907", "5907", "--log",
+                                                       "/data/p01-3/p01-42.log", "--scenario", "/srv/w.yaml",
+                                                       "59075907", "{unknown}", "plain"});
+}
+
+TEST_CASE("a replaced value is not searched for placeholders again") {
+  ManagerConfig config;
+  config.session_kind = SessionKind::kRfb;
+  config.session_args = {"{data_dir}:{port}"};
+  const LaunchContext context{1, 5900, "/data/{port}"};
+  CHECK(session_arguments(config, request("lab"), context) == Args{"/data/{port}:5900"});
+  // Also a value replaced before the placeholder it contains would be.
+  config.scenarios = {"lab=/srv/{uid}-{seed}.yaml"};
+  config.session_args = {"{scenario}", "{port}"};
+  CHECK(session_arguments(config, request("lab"), context) == Args{"/srv/{uid}-{seed}.yaml", "5900"});
+}
+
+TEST_CASE("the link's parameters as JSON") {
+  StartRequest r = request("lab");
+  CHECK(parameters_json(r, 7) == R"({"uid":"p01","scenario":"lab","seed":"7"})");
+  r.overrides = {{"avatar_start", "1.5,-2,0.25"}, {"crowd", "12"}};
+  CHECK(parameters_json(r, 18446744073709551615ULL) ==
+        R"({"uid":"p01","scenario":"lab","seed":"18446744073709551615","avatar_start":"1.5,-2,0.25","crowd":"12"})");
+}
+
+TEST_CASE("the JSON escapes what it writes") {
+  StartRequest r = request("a\"b");
+  r.uid = "x\\y";
+  CHECK(parameters_json(r, 0) == R"({"uid":"x\\y","scenario":"a\"b","seed":"0"})");
+}

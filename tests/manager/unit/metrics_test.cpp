@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+#include <catch2/catch.hpp>
+
+#include <sstream>
+
+#include "metrics.hpp"
+
+using rfbsim::manager::Metrics;
+using rfbsim::manager::Rejection;
+using rfbsim::manager::rejection_name;
+using rfbsim::manager::SessionState;
+
+namespace {
+
+// The lines of the exposition that start with `prefix`, in order.
+std::vector<std::string> lines_starting(const std::string& text, const std::string& prefix) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind(prefix, 0) == 0) out.push_back(line);
+  }
+  return out;
+}
+
+bool has_line(const std::string& text, const std::string& line) {
+  return ("\n" + text).find("\n" + line + "\n") != std::string::npos;
+}
+
+}  // namespace
+
+TEST_CASE("a new Metrics renders every series at zero") {
+  const Metrics metrics;
+  const std::string text = metrics.render({}, 4, 0);
+  CHECK(text.back() == '\n');
+  CHECK(has_line(text, "rfbsim_session_capacity 4"));
+  CHECK(has_line(text, "rfbsim_session_starts_total 0"));
+  CHECK(has_line(text, "rfbsim_session_startup_seconds_count 0"));
+  CHECK(has_line(text, "rfbsim_session_startup_seconds_sum 0"));
+  CHECK(has_line(text, "rfbsim_relay_connections 0"));
+  CHECK(has_line(text, "rfbsim_relay_connections_total 0"));
+  CHECK(has_line(text, "rfbsim_relay_bytes_total{direction=\"to_client\"} 0"));
+  CHECK(has_line(text, "rfbsim_relay_bytes_total{direction=\"to_session\"} 0"));
+}
+
+TEST_CASE("every series has its HELP and TYPE") {
+  const std::string text = Metrics().render({}, 1, 0);
+  CHECK(lines_starting(text, "# TYPE ") == std::vector<std::string>{
+                                               "# TYPE rfbsim_sessions gauge",
+                                               "# TYPE rfbsim_session_capacity gauge",
+                                               "# TYPE rfbsim_session_starts_total counter",
+                                               "# TYPE rfbsim_session_startup_seconds histogram",
+                                               "# TYPE rfbsim_relay_bytes_total counter",
+                                               "# TYPE rfbsim_relay_connections gauge",
+                                               "# TYPE rfbsim_relay_connections_total counter",
+                                               "# TYPE rfbsim_rejections_total counter",
+                                           });
+  CHECK(lines_starting(text, "# HELP ").size() == 8);
+}
+
+TEST_CASE("sessions are listed for every state, zero included") {
+  const Metrics metrics;
+  const std::string text =
+      metrics.render({{SessionState::kRunning, 2}, {SessionState::kFinished, 17}, {SessionState::kCrashed, 1}}, 4, 0);
+  CHECK(lines_starting(text, "rfbsim_sessions{") == std::vector<std::string>{
+                                                        "rfbsim_sessions{state=\"starting\"} 0",
+                                                        "rfbsim_sessions{state=\"running\"} 2",
+                                                        "rfbsim_sessions{state=\"ending\"} 0",
+                                                        "rfbsim_sessions{state=\"finished\"} 17",
+                                                        "rfbsim_sessions{state=\"expired\"} 0",
+                                                        "rfbsim_sessions{state=\"idle\"} 0",
+                                                        "rfbsim_sessions{state=\"ended\"} 0",
+                                                        "rfbsim_sessions{state=\"shutdown\"} 0",
+                                                        "rfbsim_sessions{state=\"crashed\"} 1",
+                                                        "rfbsim_sessions{state=\"failed\"} 0",
+                                                        "rfbsim_sessions{state=\"interrupted\"} 0",
+                                                    });
+}
+
+TEST_CASE("the start-up histogram's buckets are cumulative") {
+  Metrics metrics;
+  metrics.observe_startup(0.15);
+  metrics.observe_startup(0.6);
+  const std::string text = metrics.render({}, 4, 0);
+  CHECK(lines_starting(text, "rfbsim_session_startup_seconds") == std::vector<std::string>{
+            "rfbsim_session_startup_seconds_bucket{le=\"0.1\"} 0",
+            "rfbsim_session_startup_seconds_bucket{le=\"0.2\"} 1",
+            "rfbsim_session_startup_seconds_bucket{le=\"0.3\"} 1",
+            "rfbsim_session_startup_seconds_bucket{le=\"0.5\"} 1",
+            "rfbsim_session_startup_seconds_bucket{le=\"0.75\"} 2",
+            "rfbsim_session_startup_seconds_bucket{le=\"1\"} 2",
+            "rfbsim_session_startup_seconds_bucket{le=\"2\"} 2",
+            "rfbsim_session_startup_seconds_bucket{le=\"5\"} 2",
+            "rfbsim_session_startup_seconds_bucket{le=\"10\"} 2",
+            "rfbsim_session_startup_seconds_bucket{le=\"30\"} 2",
+            "rfbsim_session_startup_seconds_bucket{le=\"+Inf\"} 2",
+            "rfbsim_session_startup_seconds_sum 0.75",
+            "rfbsim_session_startup_seconds_count 2",
+        });
+}
+
+TEST_CASE("a start-up time on a bucket's bound counts in that bucket, one beyond the last only in +Inf") {
+  Metrics metrics;
+  metrics.observe_startup(0.1);
+  metrics.observe_startup(31);
+  const std::string text = metrics.render({}, 4, 0);
+  CHECK(has_line(text, "rfbsim_session_startup_seconds_bucket{le=\"0.1\"} 1"));
+  CHECK(has_line(text, "rfbsim_session_startup_seconds_bucket{le=\"30\"} 1"));
+  CHECK(has_line(text, "rfbsim_session_startup_seconds_bucket{le=\"+Inf\"} 2"));
+  CHECK(has_line(text, "rfbsim_session_startup_seconds_sum 31.1"));
+}
+
+TEST_CASE("counters count") {
+  Metrics metrics;
+  metrics.count_start();
+  metrics.count_start();
+  metrics.count_start();
+  metrics.add_bytes_to_client(1000);
+  metrics.add_bytes_to_client(24);
+  metrics.add_bytes_to_session(5);
+  metrics.count_relay_open();
+  CHECK(metrics.starts() == 3);
+  CHECK(metrics.bytes_to_client() == 1024);
+  const std::string text = metrics.render({}, 8, 1);
+  CHECK(has_line(text, "rfbsim_session_starts_total 3"));
+  CHECK(has_line(text, "rfbsim_session_capacity 8"));
+  CHECK(has_line(text, "rfbsim_relay_bytes_total{direction=\"to_client\"} 1024"));
+  CHECK(has_line(text, "rfbsim_relay_bytes_total{direction=\"to_session\"} 5"));
+  CHECK(has_line(text, "rfbsim_relay_connections 1"));
+  CHECK(has_line(text, "rfbsim_relay_connections_total 1"));
+}
+
+TEST_CASE("rejections are counted by reason and every reason is listed") {
+  Metrics metrics;
+  metrics.count_rejection(Rejection::kBusy);
+  metrics.count_rejection(Rejection::kBusy);
+  metrics.count_rejection(Rejection::kBadSignature);
+  metrics.count_rejection(Rejection::kStartFailed);
+  CHECK(metrics.rejections(Rejection::kBusy) == 2);
+  CHECK(metrics.rejections(Rejection::kBadSignature) == 1);
+  CHECK(metrics.rejections(Rejection::kUnauthorized) == 0);
+  CHECK(lines_starting(metrics.render({}, 4, 0), "rfbsim_rejections_total{") == std::vector<std::string>{
+            "rfbsim_rejections_total{reason=\"busy\"} 2",
+            "rfbsim_rejections_total{reason=\"bad_request\"} 0",
+            "rfbsim_rejections_total{reason=\"bad_signature\"} 1",
+            "rfbsim_rejections_total{reason=\"already_completed\"} 0",
+            "rfbsim_rejections_total{reason=\"unknown_session\"} 0",
+            "rfbsim_rejections_total{reason=\"ended_session\"} 0",
+            "rfbsim_rejections_total{reason=\"forbidden_origin\"} 0",
+            "rfbsim_rejections_total{reason=\"unauthorized\"} 0",
+            "rfbsim_rejections_total{reason=\"start_failed\"} 1",
+        });
+}
+
+TEST_CASE("rejection reasons have their label names") {
+  CHECK(std::string(rejection_name(Rejection::kCompleted)) == "already_completed");
+  CHECK(std::string(rejection_name(Rejection::kForbiddenOrigin)) == "forbidden_origin");
+}

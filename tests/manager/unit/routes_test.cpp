@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+#include <catch2/catch.hpp>
+
+#include "routes.hpp"
+
+using rfbsim::manager::is_token;
+using rfbsim::manager::route_request;
+using rfbsim::manager::RouteKind;
+
+namespace {
+
+const std::string kToken = "0123456789abcdef0123456789abcdef";
+
+RouteKind kind(std::string_view method, std::string_view target) { return route_request(method, target).kind; }
+
+}  // namespace
+
+TEST_CASE("the fixed paths route to their handlers") {
+  CHECK(kind("GET", "/") == RouteKind::kHome);
+  CHECK(kind("GET", "/start") == RouteKind::kStart);
+  CHECK(kind("GET", "/healthz") == RouteKind::kHealth);
+  CHECK(kind("GET", "/metrics") == RouteKind::kMetrics);
+  CHECK(kind("GET", "/api/sessions") == RouteKind::kApiSessions);
+}
+
+TEST_CASE("HEAD is taken wherever GET is") {
+  CHECK(kind("HEAD", "/") == RouteKind::kHome);
+  CHECK(kind("HEAD", "/start") == RouteKind::kStart);
+  CHECK(kind("HEAD", "/s/" + kToken + "/") == RouteKind::kSessionFile);
+  CHECK(kind("HEAD", "/api/sessions/3/end") == RouteKind::kBadMethod);
+}
+
+TEST_CASE("the admin page and its files") {
+  const auto bare = route_request("GET", "/admin");
+  CHECK(bare.kind == RouteKind::kAdminPage);
+  CHECK(bare.file.empty());
+  const auto slash = route_request("GET", "/admin/");
+  CHECK(slash.kind == RouteKind::kAdminPage);
+  CHECK(slash.file.empty());
+  const auto script = route_request("GET", "/admin/admin.js?v=2");
+  CHECK(script.kind == RouteKind::kAdminPage);
+  CHECK(script.file == "admin.js");
+  CHECK(script.query == "v=2");
+  CHECK(kind("GET", "/administrator") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/admin") == RouteKind::kBadMethod);
+}
+
+TEST_CASE("a known path with the wrong method is a bad method") {
+  CHECK(kind("POST", "/start") == RouteKind::kBadMethod);
+  CHECK(kind("PUT", "/") == RouteKind::kBadMethod);
+  CHECK(kind("DELETE", "/api/sessions") == RouteKind::kBadMethod);
+  CHECK(kind("POST", "/healthz") == RouteKind::kBadMethod);
+  CHECK(kind("POST", "/metrics") == RouteKind::kBadMethod);
+  CHECK(kind("GET", "/api/sessions/3/end") == RouteKind::kBadMethod);
+  CHECK(kind("POST", "/s/" + kToken + "/ws") == RouteKind::kBadMethod);
+  CHECK(kind("get", "/") == RouteKind::kBadMethod);  // methods are case-sensitive
+}
+
+TEST_CASE("an unknown path is not found whatever the method") {
+  CHECK(kind("GET", "/nothing") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/nothing") == RouteKind::kNotFound);
+  CHECK(kind("GET", "") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/start/") == RouteKind::kNotFound);
+  CHECK(kind("GET", "//") == RouteKind::kNotFound);
+}
+
+TEST_CASE("ending a session takes a positive decimal id") {
+  const auto route = route_request("POST", "/api/sessions/3/end");
+  CHECK(route.kind == RouteKind::kApiEndSession);
+  CHECK(route.session_id == 3);
+  CHECK(route_request("POST", "/api/sessions/9223372036854775807/end").session_id == 9223372036854775807LL);
+  CHECK(kind("POST", "/api/sessions/0/end") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions/-3/end") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions/+3/end") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions/x/end") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions/3x/end") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions/ 3/end") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions//end") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions/9223372036854775808/end") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions/3") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions/3/end/") == RouteKind::kNotFound);
+  CHECK(kind("POST", "/api/sessions/3/stop") == RouteKind::kNotFound);
+}
+
+TEST_CASE("session paths carry a token and what lies below it") {
+  SECTION("the page") {
+    const auto route = route_request("GET", "/s/" + kToken + "/");
+    CHECK(route.kind == RouteKind::kSessionFile);
+    CHECK(route.token == kToken);
+    CHECK(route.file.empty());
+  }
+  SECTION("a nested file") {
+    const auto route = route_request("GET", "/s/" + kToken + "/novnc/core/rfb.js");
+    CHECK(route.kind == RouteKind::kSessionFile);
+    CHECK(route.token == kToken);
+    CHECK(route.file == "novnc/core/rfb.js");
+  }
+  SECTION("the file is not decoded") {
+    CHECK(route_request("GET", "/s/" + kToken + "/a%20b.js").file == "a%20b.js");
+  }
+  SECTION("status") {
+    const auto route = route_request("GET", "/s/" + kToken + "/status");
+    CHECK(route.kind == RouteKind::kSessionStatus);
+    CHECK(route.token == kToken);
+  }
+  SECTION("the WebSocket") {
+    const auto route = route_request("GET", "/s/" + kToken + "/ws");
+    CHECK(route.kind == RouteKind::kSessionSocket);
+    CHECK(route.token == kToken);
+  }
+  SECTION("ws and status only as the whole rest") {
+    CHECK(kind("GET", "/s/" + kToken + "/ws/") == RouteKind::kSessionFile);
+    CHECK(kind("GET", "/s/" + kToken + "/status.json") == RouteKind::kSessionFile);
+  }
+}
+
+TEST_CASE("session paths without a valid token are not found") {
+  CHECK(kind("GET", "/s/" + kToken) == RouteKind::kNotFound);  // no trailing slash
+  CHECK(kind("GET", "/s/") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/s//") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/s/" + kToken.substr(1) + "/") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/s/" + kToken + "0/") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/s/0123456789ABCDEF0123456789abcdef/") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/s/0123456789abcdeg0123456789abcdef/ws") == RouteKind::kNotFound);
+}
+
+TEST_CASE("the query string is kept raw") {
+  const auto route = route_request("GET", "/start?uid=p%2001&scenario=lab");
+  CHECK(route.kind == RouteKind::kStart);
+  CHECK(route.query == "uid=p%2001&scenario=lab");
+  CHECK(route_request("GET", "/start").query.empty());
+  CHECK(route_request("GET", "/nothing?a=1").query == "a=1");
+  const auto ws = route_request("GET", "/s/" + kToken + "/ws?x=1");
+  CHECK(ws.kind == RouteKind::kSessionSocket);
+  CHECK(ws.query == "x=1");
+}
+
+TEST_CASE("a token is 32 lower-case hex digits") {
+  CHECK(is_token(kToken));
+  CHECK(is_token(std::string(32, 'f')));
+  CHECK_FALSE(is_token(""));
+  CHECK_FALSE(is_token(kToken.substr(0, 31)));
+  CHECK_FALSE(is_token(kToken + "0"));
+  CHECK_FALSE(is_token("0123456789ABCDEF0123456789abcdef"));
+  CHECK_FALSE(is_token("0123456789abcdeg0123456789abcdef"));
+  CHECK_FALSE(is_token("0123456789abcde-0123456789abcdef"));
+}

@@ -1,0 +1,275 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+#include <catch2/catch.hpp>
+
+#include "start_request.hpp"
+
+using rfbsim::manager::is_identifier;
+using rfbsim::manager::is_pose;
+using rfbsim::manager::kOverrideParams;
+using rfbsim::manager::parse_query;
+using rfbsim::manager::parse_start_request;
+using rfbsim::manager::QueryParams;
+using rfbsim::manager::scenario_argument;
+using rfbsim::manager::scenario_names;
+using rfbsim::manager::StartParse;
+
+namespace {
+
+const std::vector<std::string> kScenarios = {"warehouse", "lab"};
+
+// A valid link with one parameter replaced (or added).
+StartParse parse_with(const std::string& name, const std::string& value) {
+  QueryParams params = {{"uid", "p01"}, {"scenario", "lab"}};
+  bool replaced = false;
+  for (auto& param : params) {
+    if (param.first == name) {
+      param.second = value;
+      replaced = true;
+    }
+  }
+  if (!replaced) params.emplace_back(name, value);
+  return parse_start_request(params, kScenarios);
+}
+
+bool accepted(const std::string& name, const std::string& value) { return parse_with(name, value).request.has_value(); }
+
+// The seed a link with this seed value gives; nothing when refused or absent.
+std::optional<std::uint64_t> seed_of(const std::string& value) {
+  const StartParse parsed = parse_with("seed", value);
+  return parsed.request ? parsed.request->seed : std::nullopt;
+}
+
+}  // namespace
+
+TEST_CASE("a minimal link gives the uid and the default scenario, no seed and no overrides") {
+  const StartParse parsed = parse_start_request({{"uid", "p01"}}, kScenarios);
+  REQUIRE(parsed.request);
+  CHECK(parsed.error.empty());
+  CHECK(parsed.request->uid == "p01");
+  CHECK(parsed.request->scenario == "warehouse");
+  CHECK_FALSE(parsed.request->seed);
+  CHECK(parsed.request->overrides.empty());
+}
+
+TEST_CASE("a full link gives every value") {
+  const StartParse parsed = parse_start_request({{"uid", "P-01_x"},
+                                                 {"scenario", "lab"},
+                                                 {"seed", "18446744073709551615"},
+                                                 {"crowd", "500"},
+                                                 {"avatar_start", "1.5,-2,0.25"}},
+                                                kScenarios);
+  REQUIRE(parsed.request);
+  CHECK(parsed.request->uid == "P-01_x");
+  CHECK(parsed.request->scenario == "lab");
+  REQUIRE(parsed.request->seed);
+  CHECK(*parsed.request->seed == 18446744073709551615ULL);
+  const std::vector<std::pair<std::string, std::string>> overrides = {{"avatar_start", "1.5,-2,0.25"},
+                                                                      {"crowd", "500"}};
+  CHECK(parsed.request->overrides == overrides);
+}
+
+TEST_CASE("overrides come out in the order of kOverrideParams whatever the link's order") {
+  const StartParse parsed = parse_start_request({{"crowd", "3"},
+                                                 {"robot_goal", "goal_b"},
+                                                 {"uid", "p01"},
+                                                 {"avatar_goal", "0,0,0"},
+                                                 {"robot_start", "dock"},
+                                                 {"avatar_start", "start_a"}},
+                                                kScenarios);
+  REQUIRE(parsed.request);
+  const std::vector<std::pair<std::string, std::string>> overrides = {{"avatar_start", "start_a"},
+                                                                      {"avatar_goal", "0,0,0"},
+                                                                      {"robot_start", "dock"},
+                                                                      {"robot_goal", "goal_b"},
+                                                                      {"crowd", "3"}};
+  CHECK(parsed.request->overrides == overrides);
+}
+
+TEST_CASE("the override parameters and their sim_rfb flags") {
+  REQUIRE(kOverrideParams.size() == 5);
+  CHECK(std::string(kOverrideParams[0].name) == "avatar_start");
+  CHECK(std::string(kOverrideParams[0].flag) == "--avatar-start");
+  CHECK(std::string(kOverrideParams[1].name) == "avatar_goal");
+  CHECK(std::string(kOverrideParams[1].flag) == "--avatar-goal");
+  CHECK(std::string(kOverrideParams[2].name) == "robot_start");
+  CHECK(std::string(kOverrideParams[2].flag) == "--robot-start");
+  CHECK(std::string(kOverrideParams[3].name) == "robot_goal");
+  CHECK(std::string(kOverrideParams[3].flag) == "--robot-goal");
+  CHECK(std::string(kOverrideParams[4].name) == "crowd");
+  CHECK(std::string(kOverrideParams[4].flag) == "--crowd");
+}
+
+TEST_CASE("sig is ignored by the request check") {
+  const StartParse parsed = parse_start_request({{"uid", "p01"}, {"sig", "not even hex"}}, kScenarios);
+  REQUIRE(parsed.request);
+  CHECK(parsed.request->overrides.empty());
+}
+
+TEST_CASE("a bad uid is refused") {
+  CHECK(accepted("uid", std::string(64, 'a')));
+  CHECK_FALSE(accepted("uid", std::string(65, 'a')));
+  CHECK_FALSE(accepted("uid", ""));
+  CHECK_FALSE(accepted("uid", "a/b"));
+  CHECK_FALSE(accepted("uid", ".."));
+  CHECK_FALSE(accepted("uid", "a.b"));
+  CHECK_FALSE(accepted("uid", "a b"));
+  CHECK_FALSE(accepted("uid", "\xC3\xA9"));
+  CHECK(parse_with("uid", "a/b").error == "uid 'a/b' is not valid: use 1 to 64 letters, digits, '-' or '_'");
+}
+
+TEST_CASE("a uid of percent-encoded dots is refused once decoded") {
+  std::string error;
+  const auto params = parse_query("uid=%2e%2e&scenario=lab", error);
+  REQUIRE(params);
+  const StartParse parsed = parse_start_request(*params, kScenarios);
+  CHECK_FALSE(parsed.request);
+  CHECK(parsed.error == "uid '..' is not valid: use 1 to 64 letters, digits, '-' or '_'");
+}
+
+TEST_CASE("a long bad value is cut short in the message") {
+  const StartParse parsed = parse_with("uid", std::string(65, 'a'));
+  CHECK(parsed.error == "uid '" + std::string(40, 'a') + "...' is not valid: use 1 to 64 letters, digits, '-' or '_'");
+}
+
+TEST_CASE("a link without uid is refused") {
+  const StartParse parsed = parse_start_request({{"scenario", "lab"}}, kScenarios);
+  CHECK_FALSE(parsed.request);
+  CHECK(parsed.error == "the link has no uid (participant id)");
+}
+
+TEST_CASE("a scenario that is not offered is refused") {
+  CHECK(accepted("scenario", "warehouse"));
+  CHECK_FALSE(accepted("scenario", "office"));
+  CHECK_FALSE(accepted("scenario", "../etc"));
+  CHECK_FALSE(accepted("scenario", "Lab"));
+  CHECK_FALSE(accepted("scenario", ""));
+  CHECK(parse_with("scenario", "../etc").error == "scenario '../etc' is not offered here (allowed: warehouse, lab)");
+}
+
+TEST_CASE("a scenario list entry that is not an identifier cannot be asked for") {
+  // Config validation refuses such entries; the request check does not rely on it.
+  const StartParse parsed = parse_start_request({{"uid", "p01"}, {"scenario", "../etc"}}, {"../etc"});
+  CHECK_FALSE(parsed.request);
+}
+
+TEST_CASE("no scenario offered and none asked for is refused") {
+  const StartParse parsed = parse_start_request({{"uid", "p01"}}, {});
+  CHECK_FALSE(parsed.request);
+  CHECK(parsed.error == "no scenario is offered here");
+}
+
+TEST_CASE("seeds are whole decimal numbers that fit 64 bits") {
+  CHECK(seed_of("0") == std::uint64_t{0});
+  CHECK(seed_of("0042") == std::uint64_t{42});
+  CHECK(seed_of("18446744073709551615") == 18446744073709551615ULL);
+  CHECK_FALSE(accepted("seed", "18446744073709551616"));
+  CHECK_FALSE(accepted("seed", "99999999999999999999"));
+  CHECK_FALSE(accepted("seed", "-1"));
+  CHECK_FALSE(accepted("seed", "+1"));
+  CHECK_FALSE(accepted("seed", "1e3"));
+  CHECK_FALSE(accepted("seed", " 12"));
+  CHECK_FALSE(accepted("seed", "12 "));
+  CHECK_FALSE(accepted("seed", "0x10"));
+  CHECK_FALSE(accepted("seed", "1.0"));
+  CHECK_FALSE(accepted("seed", ""));
+  CHECK(parse_with("seed", "-1").error ==
+        "seed '-1' is not valid: use a whole number 0..18446744073709551615");
+}
+
+TEST_CASE("poses are spawn names or three strict decimals within bounds") {
+  SECTION("valid") {
+    CHECK(is_pose("dock_a"));
+    CHECK(is_pose("start-1"));
+    CHECK(is_pose("1,2,3"));
+    CHECK(is_pose("-1.5,0.25,-3.0"));
+    CHECK(is_pose("10000,-10000,7"));
+    CHECK(is_pose("0,0,-7"));
+  }
+  SECTION("invalid") {
+    CHECK_FALSE(is_pose(""));
+    CHECK_FALSE(is_pose("1,2"));
+    CHECK_FALSE(is_pose("1,2,3,4"));
+    CHECK_FALSE(is_pose("1,,2"));
+    CHECK_FALSE(is_pose(",1,2"));
+    CHECK_FALSE(is_pose("1,2,"));
+    CHECK_FALSE(is_pose("nan,1,0"));
+    CHECK_FALSE(is_pose("inf,1,0"));
+    CHECK_FALSE(is_pose("1e2,0,0"));
+    CHECK_FALSE(is_pose("10001,0,0"));
+    CHECK_FALSE(is_pose("0,-10000.5,0"));
+    CHECK_FALSE(is_pose("0,0,8"));
+    CHECK_FALSE(is_pose("0,0,7.01"));
+    CHECK_FALSE(is_pose("+1,0,0"));
+    CHECK_FALSE(is_pose(" 1,0,0"));
+    CHECK_FALSE(is_pose("1.,0,0"));
+    CHECK_FALSE(is_pose(".5,0,0"));
+    CHECK_FALSE(is_pose("-,0,0"));
+    CHECK_FALSE(is_pose("0x1,0,0"));
+    CHECK_FALSE(is_pose("1,2;3"));
+    CHECK_FALSE(is_pose("dock a"));
+  }
+}
+
+TEST_CASE("every pose parameter is checked") {
+  for (const char* name : {"avatar_start", "avatar_goal", "robot_start", "robot_goal"}) {
+    INFO(name);
+    CHECK(accepted(name, "dock"));
+    CHECK(accepted(name, "1,2,0.5"));
+    CHECK_FALSE(accepted(name, "1,2"));
+    CHECK_FALSE(accepted(name, "0,0,8"));
+  }
+  CHECK(parse_with("robot_goal", "1,2").error ==
+        "robot_goal '1,2' is not valid: use a spawn point's name or x,y,yaw in metres and radians");
+}
+
+TEST_CASE("crowd is a whole number 0..500") {
+  CHECK(accepted("crowd", "0"));
+  CHECK(accepted("crowd", "500"));
+  CHECK_FALSE(accepted("crowd", "501"));
+  CHECK_FALSE(accepted("crowd", "-1"));
+  CHECK_FALSE(accepted("crowd", "abc"));
+  CHECK_FALSE(accepted("crowd", ""));
+  CHECK_FALSE(accepted("crowd", "1.5"));
+  CHECK_FALSE(accepted("crowd", "dock"));   // not a pose parameter
+  CHECK(parse_with("crowd", "501").error == "crowd '501' is not valid: use a whole number 0..500");
+}
+
+TEST_CASE("an unknown parameter is refused") {
+  const StartParse parsed = parse_with("debug", "1");
+  CHECK_FALSE(parsed.request);
+  CHECK(parsed.error == "unknown parameter 'debug'");
+  CHECK_FALSE(accepted("Uid", "p02"));
+  CHECK_FALSE(accepted("seed ", "1"));
+}
+
+TEST_CASE("is_identifier allows 1 to 64 letters, digits, minus and underscore") {
+  CHECK(is_identifier("a"));
+  CHECK(is_identifier("Az09-_"));
+  CHECK(is_identifier(std::string(64, 'z')));
+  CHECK_FALSE(is_identifier(""));
+  CHECK_FALSE(is_identifier(std::string(65, 'z')));
+  CHECK_FALSE(is_identifier("a.b"));
+  CHECK_FALSE(is_identifier("a/b"));
+  CHECK_FALSE(is_identifier("a=b"));
+  CHECK_FALSE(is_identifier("a~b"));
+}
+
+TEST_CASE("scenario names and arguments come from NAME and NAME=FILE entries") {
+  const std::vector<std::string> entries = {"warehouse", "lab=/srv/scenarios/lab.yaml", "empty="};
+  CHECK(scenario_names(entries) == std::vector<std::string>{"warehouse", "lab", "empty"});
+  CHECK(scenario_argument(entries, "warehouse") == "warehouse");
+  CHECK(scenario_argument(entries, "lab") == "/srv/scenarios/lab.yaml");
+  CHECK(scenario_argument(entries, "empty").empty());
+  CHECK(scenario_argument(entries, "office") == "office");
+  CHECK(scenario_argument(entries, "lab=/srv/scenarios/lab.yaml") == "lab=/srv/scenarios/lab.yaml");
+  CHECK(scenario_names({}).empty());
+}
+
+TEST_CASE("a link naming a NAME=FILE scenario by its name is accepted") {
+  const std::vector<std::string> entries = {"warehouse", "lab=/srv/lab.yaml"};
+  const StartParse parsed = parse_start_request({{"uid", "p01"}, {"scenario", "lab"}}, scenario_names(entries));
+  REQUIRE(parsed.request);
+  CHECK(parsed.request->scenario == "lab");
+  CHECK_FALSE(parse_start_request({{"uid", "p01"}, {"scenario", "lab=/srv/lab.yaml"}}, scenario_names(entries))
+                  .request);
+}

@@ -1,0 +1,291 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// rfbsim admin page logic: lists sim_manager's live and recent sessions from /api/sessions every 2 s and ends a
+// session on request. The page and the API share one origin, so the browser resends the admin credentials (HTTP
+// Basic, the token as password) by itself.
+
+const API = '/api/sessions';
+const REFRESH_MS = 2000;
+
+// ---------------------------------------------------------------------------------------------------------------
+// Page elements (all exist in admin.html).
+// ---------------------------------------------------------------------------------------------------------------
+const ui = {
+  summary: document.getElementById('summary'),
+  message: document.getElementById('message'),
+  live: document.querySelector('#live tbody'),
+  liveEmpty: document.getElementById('live-empty'),
+  recent: document.querySelector('#recent tbody'),
+  recentEmpty: document.getElementById('recent-empty'),
+};
+
+// State, also readable by tests as window.rfbsimAdminState (read-only by convention).
+const state = {
+  updates: 0,         // answers from the API shown so far
+  error: null,        // what went wrong with the last request, in words, or null
+  lastUpdate: null,   // Date of the last answer shown
+};
+window.rfbsimAdminState = state;
+
+// ---------------------------------------------------------------------------------------------------------------
+// Formatting.
+// ---------------------------------------------------------------------------------------------------------------
+const pad = (n) => String(n).padStart(2, '0');
+
+// An ISO time from the API in local time: "HH:MM:SS" today, "YYYY-MM-DD HH:MM:SS" on other days; '' for null.
+function formatTime(iso) {
+  if (!iso) {
+    return '';
+  }
+  const t = new Date(iso);
+  if (Number.isNaN(t.getTime())) {
+    return String(iso);
+  }
+  const time = `${pad(t.getHours())}:${pad(t.getMinutes())}:${pad(t.getSeconds())}`;
+  return t.toDateString() === new Date().toDateString()
+    ? time : `${t.getFullYear()}-${pad(t.getMonth() + 1)}-${pad(t.getDate())} ${time}`;
+}
+
+// A duration in milliseconds as "42 s", "3 min 05 s" or "1 h 02 min".
+function formatDuration(ms) {
+  if (!Number.isFinite(ms) || ms < 0) {
+    return '';
+  }
+  const s = Math.floor(ms / 1000);
+  if (s < 60) {
+    return `${s} s`;
+  }
+  if (s < 3600) {
+    return `${Math.floor(s / 60)} min ${pad(s % 60)} s`;
+  }
+  return `${Math.floor(s / 3600)} h ${pad(Math.floor((s % 3600) / 60))} min`;
+}
+
+const millisBetween = (fromIso, to) => to - new Date(fromIso).getTime();
+
+// ---------------------------------------------------------------------------------------------------------------
+// Tables. Rows are kept per session id and updated in place, so a refresh never takes the keyboard focus away
+// from a link or button, and screen readers are not told about cells that did not change.
+// ---------------------------------------------------------------------------------------------------------------
+
+// Sets a cell's text only when it changed.
+function setText(cell, text) {
+  if (cell.textContent !== text) {
+    cell.textContent = text;
+  }
+}
+
+// A cell showing a session state as a small badge.
+function setState(cell, stateName, detail) {
+  let badge = cell.firstElementChild;
+  if (badge === null) {
+    badge = document.createElement('span');
+    cell.append(badge);
+  }
+  badge.className = `state state-${stateName}`;
+  setText(badge, stateName);
+  const extra = detail ? ` ${detail}` : '';
+  if ((badge.nextSibling ? badge.nextSibling.textContent : '') !== extra) {
+    if (badge.nextSibling) {
+      badge.nextSibling.remove();
+    }
+    if (extra) {
+      cell.append(extra);
+    }
+  }
+}
+
+// Makes a row of `classes.length` cells with those classes.
+function makeRow(id, classes) {
+  const row = document.createElement('tr');
+  row.dataset.id = String(id);
+  for (const cls of classes) {
+    const cell = document.createElement('td');
+    if (cls) {
+      cell.className = cls;
+    }
+    row.append(cell);
+  }
+  return row;
+}
+
+// Brings tbody's rows in line with sessions (in that order): new ones made by make(session), every one updated by
+// update(row, session), gone ones removed. Rows that stay are never moved out of the document.
+function syncRows(tbody, sessions, make, update) {
+  const rows = new Map([...tbody.rows].map((row) => [row.dataset.id, row]));
+  const wanted = new Set(sessions.map((s) => String(s.id)));
+  for (const [id, row] of rows) {
+    if (!wanted.has(id)) {
+      row.remove();
+      rows.delete(id);
+    }
+  }
+  sessions.forEach((session, index) => {
+    let row = rows.get(String(session.id));
+    if (!row) {
+      row = make(session);
+    }
+    update(row, session);
+    const there = tbody.rows[index] || null;
+    if (there !== row) {
+      tbody.insertBefore(row, there);
+    }
+  });
+}
+
+// Live sessions: id, participant, scenario, state, started, age, data folder, Watch and End.
+function makeLiveRow(session) {
+  const row = makeRow(session.id, ['num', '', '', '', 'time', 'num', 'path', 'actions']);
+  const actions = row.cells[7];
+  const watch = document.createElement('a');
+  watch.target = '_blank';
+  watch.rel = 'noopener noreferrer';
+  watch.textContent = 'Watch';
+  const end = document.createElement('button');
+  end.type = 'button';
+  end.textContent = 'End';
+  end.addEventListener('click', () => endSession(session.id, session.uid, end));
+  actions.append(watch, end);
+  return row;
+}
+
+function updateLiveRow(row, session, now) {
+  const c = row.cells;
+  setText(c[0], String(session.id));
+  setText(c[1], session.uid);
+  setText(c[2], session.scenario);
+  setState(c[3], session.state, session.state === 'ending' && session.detail ? `(${session.detail})` : '');
+  setText(c[4], formatTime(session.created_at));
+  setText(c[5], formatDuration(millisBetween(session.created_at, now)));
+  setText(c[6], session.data_path);
+  const [watch, end] = c[7].children;
+  const href = session.token ? `/s/${encodeURIComponent(session.token)}/` : '';
+  if (watch.getAttribute('href') !== href) {
+    watch.setAttribute('href', href);
+  }
+  watch.hidden = href === '';
+  watch.setAttribute('aria-label', `Watch session ${session.id} (${session.uid})`);
+  end.setAttribute('aria-label', `End session ${session.id} (${session.uid})`);
+  if (session.state === 'ending') {
+    end.disabled = true;
+  }
+}
+
+// Recent (ended) sessions: id, participant, scenario, state, started, ended, duration, detail, exit status, folder.
+function makeRecentRow(session) {
+  return makeRow(session.id, ['num', '', '', '', 'time', 'time', 'num', '', '', 'path']);
+}
+
+function updateRecentRow(row, session) {
+  const c = row.cells;
+  setText(c[0], String(session.id));
+  setText(c[1], session.uid);
+  setText(c[2], session.scenario);
+  setState(c[3], session.state, '');
+  setText(c[4], formatTime(session.created_at));
+  setText(c[5], formatTime(session.ended_at));
+  const ended = session.ended_at ? new Date(session.ended_at).getTime() : NaN;
+  setText(c[6], session.ended_at ? formatDuration(millisBetween(session.created_at, ended)) : '');
+  setText(c[7], session.detail || '');
+  setText(c[8], session.exit_status || '');
+  setText(c[9], session.data_path);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Messages and the summary line.
+// ---------------------------------------------------------------------------------------------------------------
+
+// Shows a message ('error' or 'info'); '' hides it. The same text is not set again, so it is announced once.
+function showMessage(text, kind = 'error') {
+  ui.message.className = `message ${kind}`;
+  setText(ui.message, text);
+  ui.message.hidden = text === '';
+}
+
+function render(data) {
+  const now = Date.now();
+  const live = Array.isArray(data.live) ? [...data.live].sort((a, b) => a.id - b.id) : [];
+  const recent = Array.isArray(data.recent) ? [...data.recent].sort((a, b) => b.id - a.id) : [];
+  syncRows(ui.live, live, makeLiveRow, (row, s) => updateLiveRow(row, s, now));
+  syncRows(ui.recent, recent, makeRecentRow, updateRecentRow);
+  ui.liveEmpty.hidden = live.length > 0;
+  ui.recentEmpty.hidden = recent.length > 0;
+  state.lastUpdate = new Date(now);
+  const time = formatTime(state.lastUpdate.toISOString());
+  setText(ui.summary, `${live.length} of ${data.capacity} session slots in use \u00b7 updated ${time} ` +
+                      `(every ${REFRESH_MS / 1000} s)`);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// The API.
+// ---------------------------------------------------------------------------------------------------------------
+
+// What a failed response means, in words.
+async function describeFailure(response, what) {
+  if (response.status === 401) {
+    return `Not authorised (HTTP 401) to ${what}. Reload this page and log in with the admin token as the ` +
+           'password (any user name).';
+  }
+  let detail = '';
+  try {
+    const body = await response.json();
+    detail = body && body.error ? `: ${body.error}` : '';
+  } catch (err) {
+    // not JSON: the status says enough
+  }
+  return `Could not ${what} (HTTP ${response.status}${detail}).`;
+}
+
+async function refresh() {
+  try {
+    const response = await fetch(API, { cache: 'no-store', headers: { Accept: 'application/json' } });
+    if (!response.ok) {
+      state.error = await describeFailure(response, 'list the sessions');
+    } else {
+      render(await response.json());
+      state.updates += 1;
+      state.error = null;
+    }
+  } catch (err) {
+    state.error = `The server cannot be reached (${err.message}). Retrying every ${REFRESH_MS / 1000} s.`;
+  }
+  if (state.error !== null) {
+    showMessage(state.error, 'error');
+  } else if (ui.message.classList.contains('error')) {
+    showMessage('');
+  }
+}
+
+// Ends a live session after the researcher confirms; the next refresh shows it ending.
+async function endSession(id, uid, button) {
+  const question = `End session ${id} of participant ${uid} now? Their simulation stops and cannot be resumed.`;
+  if (!window.confirm(question)) {
+    return;
+  }
+  button.disabled = true;
+  try {
+    // The custom header proves the request comes from this page: other sites cannot send it without CORS.
+    const response = await fetch(`${API}/${encodeURIComponent(id)}/end`, {
+      method: 'POST',
+      cache: 'no-store',
+      headers: { 'X-Rfbsim-Admin': '1' },
+    });
+    if (response.ok) {
+      showMessage(`Session ${id} (${uid}) is ending.`, 'info');
+    } else {
+      showMessage(await describeFailure(response, `end session ${id}`), 'error');
+      button.disabled = false;
+    }
+  } catch (err) {
+    showMessage(`Could not end session ${id}: the server cannot be reached (${err.message}).`, 'error');
+    button.disabled = false;
+  }
+  await refresh();
+}
+
+// Refreshes now, then REFRESH_MS after each answer (so slow answers never pile up).
+async function refreshLoop() {
+  await refresh();
+  setTimeout(refreshLoop, REFRESH_MS);
+}
+
+refreshLoop();
