@@ -2,6 +2,7 @@
 // Benchmark helpers: summaries, tables, list parsing, machine description.
 #include "bench_util.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -150,6 +151,21 @@ std::string load_average() {
   std::string one_minute = "?";
   loadavg >> one_minute;
   return one_minute;
+}
+
+StderrToFile::StderrToFile(const std::string& path) : saved_(::dup(STDERR_FILENO)) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    ::close(saved_);
+    throw std::runtime_error("cannot open the log " + path);
+  }
+  ::dup2(fd, STDERR_FILENO);
+  ::close(fd);
+}
+
+StderrToFile::~StderrToFile() {
+  ::dup2(saved_, STDERR_FILENO);
+  ::close(saved_);
 }
 
 }  // namespace rfbsim::bench

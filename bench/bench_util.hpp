@@ -71,4 +71,18 @@ std::string cpu_description();
 /// The one-minute load average (from /proc/loadavg): other work on the machine skews every timing.
 std::string load_average();
 
+/// Points this process's stderr at a file (appending) while the object lives, so that a child started
+/// meanwhile writes its chatter there instead of between a table's lines. Throws std::runtime_error
+/// when the file cannot be opened.
+class StderrToFile {
+ public:
+  explicit StderrToFile(const std::string& path);
+  ~StderrToFile();
+  StderrToFile(const StderrToFile&) = delete;
+  StderrToFile& operator=(const StderrToFile&) = delete;
+
+ private:
+  int saved_;  ///< a duplicate of the original stderr, put back on destruction
+};
+
 }  // namespace rfbsim::bench

@@ -4,6 +4,7 @@
 // Everything runs on one asio I/O thread (the main thread): HTTP and WebSocket through websocketpp, the
 // relays, the session processes' readiness pipes, their timers and SIGCHLD. SQLite is written from the
 // same thread, so no state is shared between threads.
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <boost/asio/io_context.hpp>
@@ -96,6 +97,13 @@ int run(ManagerConfig config) {
 
   // The relays see a vanished browser as an error code, never as a signal.
   std::signal(SIGPIPE, SIG_IGN);
+  // Each participant costs a few descriptors (their page's connections, the relay's two sockets): take
+  // every descriptor the hard limit allows rather than the customary soft 1024.
+  rlimit files{};
+  if (::getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur < files.rlim_max) {
+    files.rlim_cur = files.rlim_max;
+    ::setrlimit(RLIMIT_NOFILE, &files);
+  }
   boost::asio::io_context io;
   manager::Metrics metrics;
   manager::Supervisor supervisor(io, config, program, index, metrics);
