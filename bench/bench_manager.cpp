@@ -15,22 +15,20 @@
 //   3. Capacity: sessions at 20 fps added one at a time, each watched by one client through the relay;
 //      after each, every client's updates per second, until the slowest falls below 19.
 // Tables 1 and 2 share one manager; table 3 has its own (the frame rate is a manager-wide session arg).
-#include <sqlite3.h>
+// The manager runs as rfbsim::test::ManagerUnderTest (tests/support, shared with the manager's process tests);
+// the clients and their fingerprints are in manager_clients.hpp.
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <ctime>
 #include <exception>
 #include <filesystem>
 #include <fstream>
-#include <map>
+#include <functional>
 #include <memory>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -38,21 +36,18 @@
 
 #include "bench_util.hpp"
 #include "http_client.hpp"
-#include "rfb_test_client.hpp"
-#include "sim_process.hpp"
-#include "ws_rfb_bridge.hpp"
-
-#ifndef RFBSIM_BENCH_SIM_MANAGER
-#define RFBSIM_BENCH_SIM_MANAGER "sim_manager"
-#endif
+#include "manager_clients.hpp"
+#include "manager_process.hpp"
 
 namespace {
 
 namespace bench = rfbsim::bench;
 namespace net = rfbsim::test::net;
+using bench::Arrival;
 using bench::Clock;
-using rfbsim::test::RfbTestClient;
-using rfbsim::test::WsRfbBridge;
+using bench::WatchedClient;
+using rfbsim::test::IndexRow;
+using rfbsim::test::ManagerUnderTest;
 using std::chrono::milliseconds;
 
 constexpr auto kFirstUpdateTimeout = milliseconds(30000);  // link to first update, and session start
@@ -74,7 +69,7 @@ struct Options {
   int seconds = 10;
   int max_capacity = 8;
   bool skip_capacity = false;
-  std::string manager = RFBSIM_BENCH_SIM_MANAGER;
+  std::string manager = rfbsim::test::sim_manager_path();  // $RFBSIM_SIM_MANAGER, or the one built here
   std::string log = (std::filesystem::temp_directory_path() / "rfbsim_bench_manager.log").string();
 };
 
@@ -120,15 +115,6 @@ Options parse_options(int argc, char** argv) {
 // The manager under measurement
 // ----------------------------------------------------------------------------------------------------------
 
-// One session's row in the manager's index, as far as the benchmark needs it.
-struct IndexRow {
-  std::int64_t id = 0;
-  std::string state;
-  int port = 0;
-  std::string created_at, ready_at;  // ISO 8601 UTC with milliseconds; ready_at "" while not ready
-  std::string data_path;
-};
-
 // Milliseconds since the epoch of an index time such as "2025-01-31T12:00:00.123Z"; NaN if unparseable.
 double iso_ms(const std::string& text) {
   std::tm parts{};
@@ -144,112 +130,51 @@ double iso_ms(const std::string& text) {
 
 bool is_live_state(const std::string& state) { return state == "starting" || state == "running" || state == "ending"; }
 
-// A sim_manager on a free loopback port with a fresh data folder; SIGTERM (which ends its sessions) and
-// the folder's removal on destruction. Its stderr, and its sessions' launch chatter, go to the log.
-class Manager {
- public:
-  Manager(const Options& options, const std::vector<std::string>& session_args, int max_sessions)
-      : data_dir_(std::filesystem::temp_directory_path() /
-                  ("rfbsim-bench-manager-" + std::to_string(::getpid()) + "-" + std::to_string(next_id_++))) {
-    std::filesystem::remove_all(data_dir_);
-    std::filesystem::create_directories(data_dir_);
-    std::vector<std::string> args = {"--port", "0", "--data-dir", data_dir_.string(), "--max-sessions",
-                                     std::to_string(max_sessions), "--admin-token", kAdminToken, "--scenarios",
-                                     options.scenario, "--max-duration-s", "3600"};
-    for (const std::string& arg : session_args) args.insert(args.end(), {"--session-arg", arg});
-    const bench::StderrToFile redirect(options.log);
-    process_ = std::make_unique<rfbsim::test::SimProcess>(options.manager, args);
-  }
-  ~Manager() {
-    process_->stop(SIGTERM, milliseconds(30000));
-    std::error_code ignored;
-    std::filesystem::remove_all(data_dir_, ignored);
-  }
-  Manager(const Manager&) = delete;
-  Manager& operator=(const Manager&) = delete;
+// A sim_manager on a free loopback port with its data in `data_dir`, as the benchmark runs it: SIGTERM on
+// destruction, which ends its sessions, and the index polled every 5 ms (table 1 times "admin end -> session
+// gone" by polling it). Its stderr, and its sessions' launch chatter, go to the log.
+ManagerUnderTest start_manager(const Options& options, const std::filesystem::path& data_dir,
+                               const std::vector<std::string>& session_args, int max_sessions) {
+  std::vector<std::string> flags = {"--max-sessions", std::to_string(max_sessions), "--admin-token", kAdminToken,
+                                    "--scenarios", options.scenario, "--max-duration-s", "3600"};
+  for (const std::string& arg : session_args) flags.insert(flags.end(), {"--session-arg", arg});
+  rfbsim::test::ManagerOptions how;
+  how.program = options.manager;
+  how.stop_signal = SIGTERM;
+  how.stop_timeout = milliseconds(30000);
+  how.poll_interval = milliseconds(5);
+  const bench::StderrToFile redirect(options.log);
+  return ManagerUnderTest(data_dir, flags, how);
+}
 
-  [[nodiscard]] int port() const { return process_->port(); }
-  /// The Origin a browser on the manager's own page sends.
-  [[nodiscard]] std::string origin() const { return "http://127.0.0.1:" + std::to_string(port()); }
-  [[nodiscard]] std::string ws_url(const std::string& token) const {
-    return "ws://127.0.0.1:" + std::to_string(port()) + "/s/" + token + "/ws";
+// GET /start for `uid`; returns the token of the 302's /s/<token>/, throws on any other answer.
+std::string start_session(const ManagerUnderTest& manager, const std::string& uid, const std::string& scenario) {
+  const net::HttpResponse response = manager.start("uid=" + uid + "&scenario=" + scenario);
+  const std::string token = rfbsim::test::token_from_redirect(response);
+  if (token.empty()) {
+    throw std::runtime_error("/start for uid " + uid + " answered " + std::to_string(response.status) + ": " +
+                             response.body.substr(0, 200));
   }
+  return token;
+}
 
-  /// GET /start for `uid`; returns the token of the 302's /s/<token>/, throws on any other answer.
-  std::string start(const std::string& uid, const std::string& scenario) const {
-    const net::HttpResponse response = net::http_get(port(), "/start?uid=" + uid + "&scenario=" + scenario);
-    const auto location = response.headers.find("location");
-    if (response.status != 302 || location == response.headers.end() || location->second.size() != 3 + 32 + 1 ||
-        location->second.rfind("/s/", 0) != 0) {
-      throw std::runtime_error("/start for uid " + uid + " answered " + std::to_string(response.status) + ": " +
-                               response.body.substr(0, 200));
-    }
-    return location->second.substr(3, 32);
+// POST /api/sessions/<id>/end; throws unless the manager accepted it.
+void end_session(const ManagerUnderTest& manager, std::int64_t id) {
+  const net::HttpResponse response = manager.end_session(id, kAdminToken);
+  if (response.status != 200) {
+    throw std::runtime_error("ending session " + std::to_string(id) + " answered " + std::to_string(response.status) +
+                             ": " + response.body);
   }
+}
 
-  /// POST /api/sessions/<id>/end; throws unless the manager accepted it.
-  void end(std::int64_t id) const {
-    const std::string request = "POST /api/sessions/" + std::to_string(id) +
-                                "/end HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " + kAdminToken +
-                                "\r\nX-Rfbsim-Admin: 1\r\nContent-Length: 0\r\nConnection: close\r\n\r\n";
-    const net::HttpResponse response = net::http_request(port(), request);
-    if (response.status != 200) {
-      throw std::runtime_error("ending session " + std::to_string(id) + " answered " +
-                               std::to_string(response.status) + ": " + response.body);
-    }
-  }
-
-  /// The index row of the session with `token`, read with our own SQLite connection.
-  [[nodiscard]] std::optional<IndexRow> row(const std::string& token) const {
-    sqlite3* db = nullptr;
-    const std::string path = (data_dir_ / "sessions.db").string();
-    if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
-      sqlite3_close(db);
-      throw std::runtime_error("cannot open " + path);
-    }
-    sqlite3_busy_timeout(db, 5000);
-    sqlite3_stmt* stmt = nullptr;
-    const char* sql =
-        "SELECT id, state, port, created_at, ifnull(ready_at, ''), data_path FROM sessions WHERE token = ?";
-    std::optional<IndexRow> found;
-    if (sqlite3_prepare_v2(db, sql, -1, &stmt, nullptr) == SQLITE_OK) {
-      sqlite3_bind_text(stmt, 1, token.c_str(), -1, SQLITE_TRANSIENT);
-      const auto text = [stmt](int column) {
-        const auto* value = sqlite3_column_text(stmt, column);
-        return value == nullptr ? std::string() : std::string(reinterpret_cast<const char*>(value));
-      };
-      if (sqlite3_step(stmt) == SQLITE_ROW) {
-        found = IndexRow{sqlite3_column_int64(stmt, 0), text(1), sqlite3_column_int(stmt, 2), text(3), text(4),
-                         text(5)};
-      }
-    }
-    const std::string error = stmt == nullptr ? sqlite3_errmsg(db) : "";
-    sqlite3_finalize(stmt);
-    sqlite3_close(db);
-    if (!error.empty()) throw std::runtime_error("index query failed: " + error);
-    return found;
-  }
-
-  /// Polls the index until the session's row satisfies `done`; throws after `timeout`.
-  template <typename Done>
-  IndexRow wait_for_row(const std::string& token, Done done, milliseconds timeout, const char* what) const {
-    const auto deadline = Clock::now() + timeout;
-    for (;;) {
-      const auto found = row(token);
-      if (found && done(*found)) return *found;
-      if (Clock::now() > deadline) {
-        throw std::runtime_error(std::string("session ") + token + " never " + what + " (state " +
-                                 (found ? found->state : "absent") + ")");
-      }
-      std::this_thread::sleep_for(milliseconds(5));
-    }
-  }
-
- private:
-  static inline int next_id_ = 0;
-  std::filesystem::path data_dir_;
-  std::unique_ptr<rfbsim::test::SimProcess> process_;
-};
+// Polls the index until the session's row satisfies `done`; throws after `timeout`, saying what it never did.
+IndexRow wait_for_row(const ManagerUnderTest& manager, const std::string& token,
+                      const std::function<bool(const IndexRow&)>& done, milliseconds timeout, const char* what) {
+  if (auto row = manager.wait_for_row(token, done, timeout)) return *row;
+  const auto last = manager.row_for_token(token);
+  throw std::runtime_error(std::string("session ") + token + " never " + what + " (state " +
+                           (last ? last->state : "absent") + ")");
+}
 
 // The renderer a session announced in its log ("[sim_rfb] rendering with ...").
 std::string session_renderer(const IndexRow& row) {
@@ -262,137 +187,6 @@ std::string session_renderer(const IndexRow& row) {
   }
   return "unknown";
 }
-
-// ----------------------------------------------------------------------------------------------------------
-// A client that consumes updates on its own thread
-// ----------------------------------------------------------------------------------------------------------
-
-// A 64-bit hash of a picture's colour (the undefined alpha byte masked off): equal pictures, equal hashes.
-std::uint64_t picture_hash(const rfbsim::FrameView& frame) {
-  constexpr std::uint64_t kColour = 0x00FFFFFF00FFFFFFULL;
-  std::uint64_t h = 0x9E3779B97F4A7C15ULL;
-  const std::size_t row_bytes = static_cast<std::size_t>(frame.width) * 4U;
-  for (int y = 0; y < frame.height; ++y) {
-    const std::uint8_t* row = frame.row(y);
-    std::size_t i = 0;
-    for (; i + 8 <= row_bytes; i += 8) {
-      std::uint64_t word = 0;
-      std::memcpy(&word, row + i, 8);
-      h = (h ^ (word & kColour)) * 0x100000001B3ULL;
-      h ^= h >> 29;
-    }
-    if (i < row_bytes) {  // an odd width's last pixel
-      std::uint32_t pixel = 0;
-      std::memcpy(&pixel, row + i, 4);
-      h = (h ^ (pixel & 0x00FFFFFFU)) * 0x100000001B3ULL;
-    }
-  }
-  return h;
-}
-
-// The picture's luma averaged over 4x4-pixel blocks. Two clients showing the same frame rarely hold
-// identical pixels: each picture keeps its own JPEG history (its first full update, and rectangles grouped
-// by when its requests arrived), but they differ by a few levels of JPEG noise, which the averaging
-// flattens; two consecutive frames of a moving crowd differ by far more (see kSameFrameCells).
-constexpr int kThumbBlock = 4;
-std::vector<std::uint8_t> picture_thumb(const rfbsim::FrameView& frame) {
-  const int tw = frame.width / kThumbBlock;
-  const int th = frame.height / kThumbBlock;
-  std::vector<std::uint32_t> sum(static_cast<std::size_t>(tw) * static_cast<std::size_t>(th), 0);
-  for (int y = 0; y < th * kThumbBlock; ++y) {
-    const std::uint8_t* row = frame.row(y);
-    std::uint32_t* out = sum.data() + static_cast<std::size_t>(y / kThumbBlock) * static_cast<std::size_t>(tw);
-    for (int x = 0; x < tw * kThumbBlock; ++x) {
-      const std::uint8_t* p = row + static_cast<std::size_t>(x) * 4U;
-      out[x / kThumbBlock] += 2U * p[0] + 5U * p[1] + p[2];  // luma, weights summing to 8
-    }
-  }
-  std::vector<std::uint8_t> thumb(sum.size());
-  constexpr std::uint32_t kDivisor = 8U * kThumbBlock * kThumbBlock;
-  for (std::size_t i = 0; i < sum.size(); ++i) thumb[i] = static_cast<std::uint8_t>(sum[i] / kDivisor);
-  return thumb;
-}
-
-// Thumbnail cells that differ by more than kNoiseLevels; counting stops past `limit`.
-constexpr int kNoiseLevels = 8;
-int thumb_distance(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b, int limit) {
-  if (a.size() != b.size()) return limit + 1;
-  int count = 0;
-  for (std::size_t i = 0; i < a.size() && count <= limit; ++i) count += std::abs(int{a[i]} - int{b[i]}) > kNoiseLevels;
-  return count;
-}
-
-struct Arrival {
-  Clock::time_point at;              // when the update completed at the client
-  std::uint64_t hash = 0;            // the client's picture after it (0 without fingerprints)
-  std::vector<std::uint8_t> thumb;   // its picture_thumb (empty without fingerprints)
-};
-
-// An RfbTestClient behind its own WsRfbBridge; construction returns once the RFB handshake is done.
-// start() pumps updates on a thread of its own; counts may be read meanwhile, arrivals after stop().
-// With `fingerprints`, each arrival also carries the picture's hash and thumbnail (a few ms per update).
-class WatchedClient {
- public:
-  WatchedClient(const std::string& ws_url, const std::string& origin, bool fingerprints)
-      : bridge_(ws_url, origin), client_(connect(bridge_)), fingerprints_(fingerprints) {}
-  ~WatchedClient() { stop(); }
-  WatchedClient(const WatchedClient&) = delete;
-  WatchedClient& operator=(const WatchedClient&) = delete;
-
-  void start() {
-    thread_ = std::thread([this] { pump(); });
-  }
-  void stop() {
-    stopping_ = true;
-    if (thread_.joinable()) thread_.join();
-  }
-  /// Complete updates received so far (any thread).
-  [[nodiscard]] std::uint64_t updates() const { return updates_.load(); }
-  /// Every update received while pumping, in order (after stop()).
-  [[nodiscard]] const std::vector<Arrival>& arrivals() const { return arrivals_; }
-  [[nodiscard]] bool connected() const { return connected_.load(); }
-
- private:
-  static RfbTestClient connect(const WsRfbBridge& bridge) {
-    try {
-      return RfbTestClient("127.0.0.1", bridge.port());
-    } catch (const std::runtime_error& error) {
-      const auto last = bridge.last();
-      throw std::runtime_error(std::string(error.what()) + " (WebSocket handshake status " +
-                               std::to_string(last.handshake_status) + (last.error.empty() ? "" : ", " + last.error) +
-                               ")");
-    }
-  }
-
-  void pump() {
-    std::uint64_t seen = client_.updates();
-    // The arrival time is taken first, as soon as libvncclient has handled the whole update.
-    const auto record = [&] {
-      if (client_.updates() != seen) {
-        const Arrival arrival{Clock::now(), 0, {}};
-        seen = client_.updates();
-        updates_.store(seen);
-        arrivals_.push_back(arrival);
-        if (fingerprints_) {
-          arrivals_.back().hash = picture_hash(client_.frame());
-          arrivals_.back().thumb = picture_thumb(client_.frame());
-        }
-      }
-      return stopping_.load();
-    };
-    while (!stopping_ && client_.connected()) client_.pump_until(record, milliseconds(200));
-    connected_ = client_.connected();
-  }
-
-  WsRfbBridge bridge_;
-  RfbTestClient client_;
-  bool fingerprints_;  // hash and thumbnail each picture (table 2)
-  std::atomic<bool> stopping_{false};
-  std::atomic<bool> connected_{true};
-  std::atomic<std::uint64_t> updates_{0};
-  std::vector<Arrival> arrivals_;
-  std::thread thread_;
-};
 
 // ----------------------------------------------------------------------------------------------------------
 // 1. Link to first frame
@@ -415,13 +209,13 @@ double wall_ms(std::chrono::system_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(t.time_since_epoch()).count();
 }
 
-FirstFrameResult run_first_frame(const Options& options, const Manager& manager) {
+FirstFrameResult run_first_frame(const Options& options, const ManagerUnderTest& manager) {
   FirstFrameResult r;
   for (int i = 0; i < options.sessions; ++i) {
     const std::string uid = "bench-first-" + std::to_string(::getpid()) + "-" + std::to_string(i);
     const double t0_wall = wall_ms(std::chrono::system_clock::now());
     const auto t0 = Clock::now();
-    const std::string token = manager.start(uid, options.scenario);
+    const std::string token = start_session(manager, uid, options.scenario);
     const auto redirected = Clock::now();
     // The page's script opens the WebSocket right away; the manager holds it until the session is ready.
     auto client = std::make_unique<WatchedClient>(manager.ws_url(token), manager.origin(), false);
@@ -435,7 +229,7 @@ FirstFrameResult run_first_frame(const Options& options, const Manager& manager)
     client->stop();
     const auto first = client->arrivals().front().at;
 
-    const IndexRow row = manager.wait_for_row(token, [](const IndexRow& x) { return !x.ready_at.empty(); },
+    const IndexRow row = wait_for_row(manager, token, [](const IndexRow& x) { return !x.ready_at.empty(); },
                                               kFirstUpdateTimeout, "became ready");
     if (i == 0) r.renderer = session_renderer(row);
     const double ready = iso_ms(row.ready_at) - t0_wall;
@@ -449,8 +243,8 @@ FirstFrameResult run_first_frame(const Options& options, const Manager& manager)
 
     // Free the capacity, and wait until the session is really gone, before the next link.
     const auto end_sent = Clock::now();
-    manager.end(row.id);
-    manager.wait_for_row(token, [](const IndexRow& x) { return !is_live_state(x.state); }, kEndTimeout, "ended");
+    end_session(manager, row.id);
+    wait_for_row(manager, token, [](const IndexRow& x) { return !is_live_state(x.state); }, kEndTimeout, "ended");
     r.end_ms.push_back(bench::ms_between(end_sent, Clock::now()));
   }
   return r;
@@ -484,7 +278,7 @@ RelayRound match_updates(const std::vector<Arrival>& a, const std::vector<Arriva
     int best_distance = kSameFrameCells + 1;
     for (std::size_t j = window_start; j < b.size() && b[j].at <= x.at + kMatchWindow; ++j) {
       if (taken[j]) continue;
-      const int d = thumb_distance(x.thumb, b[j].thumb, best_distance);
+      const int d = bench::thumb_distance(x.thumb, b[j].thumb, best_distance);
       if (d < best_distance) {
         best = j;
         best_distance = d;
@@ -504,10 +298,10 @@ RelayRound match_updates(const std::vector<Arrival>& a, const std::vector<Arriva
   return round;
 }
 
-std::vector<RelayRound> run_relay(const Options& options, const Manager& manager) {
+std::vector<RelayRound> run_relay(const Options& options, const ManagerUnderTest& manager) {
   const std::string uid = "bench-relay-" + std::to_string(::getpid());
-  const std::string token = manager.start(uid, options.scenario);
-  const IndexRow row = manager.wait_for_row(token, [](const IndexRow& x) { return x.state == "running"; },
+  const std::string token = start_session(manager, uid, options.scenario);
+  const IndexRow row = wait_for_row(manager, token, [](const IndexRow& x) { return x.state == "running"; },
                                             kFirstUpdateTimeout, "became ready");
   const std::string direct_url = "ws://127.0.0.1:" + std::to_string(row.port) + "/";
   // libvncserver refuses a WebSocket handshake without an Origin header.
@@ -536,8 +330,8 @@ std::vector<RelayRound> run_relay(const Options& options, const Manager& manager
     round.first_connected = direct_first ? "A (direct)" : "B (relay)";
     rounds.push_back(std::move(round));
   }
-  manager.end(row.id);
-  manager.wait_for_row(token, [](const IndexRow& x) { return !is_live_state(x.state); }, kEndTimeout, "ended");
+  end_session(manager, row.id);
+  wait_for_row(manager, token, [](const IndexRow& x) { return !is_live_state(x.state); }, kEndTimeout, "ended");
   return rounds;
 }
 
@@ -552,13 +346,13 @@ struct CapacityRow {
   std::string load;
 };
 
-std::vector<CapacityRow> run_capacity(const Options& options, const Manager& manager) {
+std::vector<CapacityRow> run_capacity(const Options& options, const ManagerUnderTest& manager) {
   std::vector<std::unique_ptr<WatchedClient>> clients;
   std::vector<CapacityRow> rows;
   for (int n = 1; n <= options.max_capacity; ++n) {
     const auto t0 = Clock::now();
-    const std::string token = manager.start("bench-capacity-" + std::to_string(::getpid()) + "-" + std::to_string(n),
-                                            options.scenario);
+    const std::string token = start_session(
+        manager, "bench-capacity-" + std::to_string(::getpid()) + "-" + std::to_string(n), options.scenario);
     clients.push_back(std::make_unique<WatchedClient>(manager.ws_url(token), manager.origin(), false));
     CapacityRow row;
     row.sessions = n;
@@ -603,13 +397,17 @@ int run(const Options& options) {
   FirstFrameResult first;
   std::vector<RelayRound> relay;
   {
-    const Manager manager(options, {}, 2);
+    const rfbsim::test::TempDir data("rfbsim-bench-manager");  // outlives the manager
+    const ManagerUnderTest manager = start_manager(options, data.path(), {}, 2);
     first = run_first_frame(options, manager);
     relay = run_relay(options, manager);
   }
   std::vector<CapacityRow> capacity;
   if (!options.skip_capacity) {
-    const Manager manager(options, {"--fps", std::to_string(static_cast<int>(kCapacityFps))}, options.max_capacity);
+    const rfbsim::test::TempDir data("rfbsim-bench-manager");  // outlives the manager
+    const ManagerUnderTest manager = start_manager(options, data.path(),
+                                                   {"--fps", std::to_string(static_cast<int>(kCapacityFps))},
+                                                   options.max_capacity);
     capacity = run_capacity(options, manager);
   }
 

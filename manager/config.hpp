@@ -17,9 +17,17 @@ enum class SessionKind {
             ///< {data_dir}; ready once the port accepts a connection
 };
 
+/// The default RLIMIT_AS of sessions, MiB. AddressSanitizer builds (scripts/test.sh --sanitize) reserve
+/// terabytes of shadow address space, which any limit would refuse, so there it is off.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr std::uint64_t kDefaultAddressSpaceMb = 0;
+#else
+inline constexpr std::uint64_t kDefaultAddressSpaceMb = 8192;
+#endif
+
 /// Resource limits applied to every session process (0 = no limit).
 struct ProcessLimits {
-  std::uint64_t address_space_mb = 8192;  ///< RLIMIT_AS, MiB (llvmpipe reserves a lot of address space)
+  std::uint64_t address_space_mb = kDefaultAddressSpaceMb;  ///< RLIMIT_AS, MiB (llvmpipe reserves a lot)
   std::uint64_t open_files = 1024;        ///< RLIMIT_NOFILE
   /// RLIMIT_CPU = max_duration x cpu_time_factor + cpu_slack: a session may use about this many cores on
   /// average (renderer threads) and the slack covers start-up and the stop grace period.

@@ -218,7 +218,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
       case RouteKind::kBadMethod:
         metrics_.count_rejection(Rejection::kBadRequest);
         respond_page(con, 405, error_page(405, "Method not allowed", "This address does not take that method."),
-                     {{"Allow", route.kind == RouteKind::kApiEndSession ? "POST" : "GET, HEAD"}});
+                     {{"Allow", route.allowed}});
         return;
       case RouteKind::kNotFound:
         break;
@@ -431,7 +431,12 @@ class FrontendImpl final : public Frontend, public SessionListener {
     auto con = server_.get_con_from_hdl(hdl);
     Session* session = supervisor_.table().by_token(session_token);
     if (session == nullptr || session->state == SessionState::kEnding) {
-      const auto [code, reason] = close_for(session ? session->end_as : SessionState::kCrashed);
+      // It ended between the handshake's check and now: say how, as for any other ending.
+      const auto ended = supervisor_.find(session_token);
+      const SessionState state = !ended ? SessionState::kCrashed
+                                 : ended->state == SessionState::kEnding ? ended->end_as
+                                                                         : ended->state;
+      const auto [code, reason] = close_for(state);
       websocketpp::lib::error_code ec;
       con->close(code, reason, ec);
       return;

@@ -13,7 +13,10 @@ namespace {
 constexpr std::size_t kTokenLength = 32;
 
 Route with_method(Route route, std::string_view method, std::string_view wanted) {
-  if (method != wanted && !(wanted == "GET" && method == "HEAD")) route.kind = RouteKind::kBadMethod;
+  if (method != wanted && !(wanted == "GET" && method == "HEAD")) {
+    route.kind = RouteKind::kBadMethod;
+    route.allowed = wanted == "GET" ? "GET, HEAD" : "POST";
+  }
   return route;
 }
 

@@ -30,6 +30,7 @@ struct Route {
   std::string file;       ///< kSessionFile, kAdminPage: the rest of the path after the prefix (not decoded)
   std::int64_t session_id = 0;  ///< kApiEndSession
   std::string query;      ///< the raw query string (after '?')
+  const char* allowed = "GET, HEAD";  ///< kBadMethod: the methods the path takes (an Allow header)
 };
 
 /// Routes a request by method and target ("/path?query").

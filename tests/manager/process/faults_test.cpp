@@ -7,7 +7,7 @@
 #include <csignal>
 #include <sys/wait.h>
 
-#include "manager_fixture.hpp"
+#include "manager_process.hpp"
 #include "rfb_test_client.hpp"
 #include "ws_rfb_bridge.hpp"
 
@@ -17,29 +17,16 @@ using rfbsim::test::RfbTestClient;
 using rfbsim::test::TempDir;
 using rfbsim::test::WsRfbBridge;
 using rfbsim::test::token_from_redirect;
-
-namespace {
-
-std::string ws_url(const ManagerUnderTest& manager, const std::string& token) {
-  return "ws://127.0.0.1:" + std::to_string(manager.port()) + "/s/" + token + "/ws";
-}
-
-std::vector<std::string> with_small(std::vector<std::string> flags) {
-  const auto small = rfbsim::test::small_session_args();
-  flags.insert(flags.end(), small.begin(), small.end());
-  return flags;
-}
-
-}  // namespace
+using rfbsim::test::with_small_sessions;
 
 TEST_CASE("a session killed with SIGKILL is marked crashed and its slot is free at once", "[manager]") {
   TempDir data;
-  ManagerUnderTest manager(data.path(), with_small({"--max-sessions", "1"}));
+  ManagerUnderTest manager(data.path(), with_small_sessions({"--max-sessions", "1"}));
   const std::string token = token_from_redirect(manager.start("uid=crash-1"));
   REQUIRE(manager.wait_for_state(token, "running"));
   const auto row = manager.row_for_token(token);
   REQUIRE(row);
-  WsRfbBridge bridge(ws_url(manager, token));
+  WsRfbBridge bridge(manager.ws_url(token));
   RfbTestClient client("127.0.0.1", bridge.port());
   REQUIRE(client.wait_for_updates(1, 20s));
   CHECK(manager.start("uid=crash-2").status == 503);  // full
@@ -90,7 +77,7 @@ TEST_CASE("a manager killed with SIGKILL leaves no session behind, and its succe
   REQUIRE(rows.size() == 2);
   for (const auto& row : rows) {
     CHECK(row.state == "interrupted");
-    CHECK(row.ended_at_set);
+    CHECK_FALSE(row.ended_at.empty());
     CHECK(row.detail == "the manager stopped unexpectedly while the session ran");
   }
   CHECK(successor.state_of(tokens[0]) == "interrupted");
@@ -108,7 +95,7 @@ TEST_CASE("a browser that vanishes mid-stream costs only its own connection", "[
   const std::string token = token_from_redirect(manager.start("uid=vanish-1"));
   REQUIRE(token.size() == 32);
   {
-    auto bridge = std::make_unique<WsRfbBridge>(ws_url(manager, token));
+    auto bridge = std::make_unique<WsRfbBridge>(manager.ws_url(token));
     RfbTestClient client("127.0.0.1", bridge->port());
     REQUIRE(client.wait_for_updates(3, 20s));
     bridge.reset();  // drops the WebSocket without a close handshake, in the middle of the stream
@@ -116,7 +103,7 @@ TEST_CASE("a browser that vanishes mid-stream costs only its own connection", "[
   REQUIRE(rfbsim::test::eventually([&] { return manager.metric("rfbsim_relay_connections") == 0; }, 10s));
   CHECK(manager.state_of(token) == "running");
   // The participant comes back and is served as before.
-  WsRfbBridge bridge(ws_url(manager, token));
+  WsRfbBridge bridge(manager.ws_url(token));
   RfbTestClient client("127.0.0.1", bridge.port());
   CHECK(client.wait_for_updates(2, 20s));
   CHECK(manager.get("/healthz").status == 200);

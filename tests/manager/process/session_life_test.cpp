@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <sys/wait.h>
 
-#include "manager_fixture.hpp"
+#include "manager_process.hpp"
 #include "rfb_test_client.hpp"
 #include "ws_rfb_bridge.hpp"
 
@@ -21,10 +21,6 @@ using rfbsim::test::TempDir;
 using rfbsim::test::WsRfbBridge;
 
 namespace {
-
-std::string ws_url(const ManagerUnderTest& manager, const std::string& token) {
-  return "ws://127.0.0.1:" + std::to_string(manager.port()) + "/s/" + token + "/ws";
-}
 
 // Whether a frame has a picture in it: not one flat colour.
 bool has_picture(const rfbsim::FrameView& frame) {
@@ -43,10 +39,7 @@ bool has_picture(const rfbsim::FrameView& frame) {
 TEST_CASE("a link starts a session, redirects at once, and the first frame arrives through the relay",
           "[manager]") {
   TempDir data;
-  std::vector<std::string> flags = {"--scenarios", "lab,warehouse"};
-  const auto small = rfbsim::test::small_session_args();
-  flags.insert(flags.end(), small.begin(), small.end());
-  ManagerUnderTest manager(data.path(), flags);
+  ManagerUnderTest manager(data.path(), rfbsim::test::with_small_sessions({"--scenarios", "lab,warehouse"}));
 
   const auto response = manager.start("uid=p-01&scenario=lab&seed=42");
   REQUIRE(response.status == 302);
@@ -62,7 +55,7 @@ TEST_CASE("a link starts a session, redirects at once, and the first frame arriv
   CHECK(page.headers.at("cache-control") == "no-store");
   CHECK(page.headers.at("referrer-policy") == "no-referrer");
 
-  WsRfbBridge bridge(ws_url(manager, token));
+  WsRfbBridge bridge(manager.ws_url(token));
   RfbTestClient client("127.0.0.1", bridge.port());
   REQUIRE(client.wait_for_updates(1, 20s));
   CHECK(client.width() == 320);
@@ -80,7 +73,7 @@ TEST_CASE("a link starts a session, redirects at once, and the first frame arriv
   CHECK(row->seed == "42");
   CHECK(row->state == "running");
   CHECK(row->params == R"({"uid":"p-01","scenario":"lab","seed":"42"})");
-  CHECK(row->ready_at_set);
+  CHECK_FALSE(row->ready_at.empty());
   CHECK(rfbsim::test::process_exists(static_cast<pid_t>(row->pid)));
   CHECK(std::filesystem::is_regular_file(std::filesystem::path(row->data_path) / "session.log"));
   CHECK(manager.metric("rfbsim_relay_bytes_total{direction=\"to_client\"}") > 1000);
@@ -107,7 +100,7 @@ TEST_CASE("a link starts a session, redirects at once, and the first frame arriv
     REQUIRE(rows.size() == 2);
     CHECK(rows[0].pid != rows[1].pid);
     CHECK(rows[1].scenario == "warehouse");
-    WsRfbBridge other_bridge(ws_url(manager, other));
+    WsRfbBridge other_bridge(manager.ws_url(other));
     RfbTestClient other_client("127.0.0.1", other_bridge.port());
     CHECK(other_client.wait_for_updates(1, 20s));
   }
@@ -115,12 +108,11 @@ TEST_CASE("a link starts a session, redirects at once, and the first frame arriv
 
 TEST_CASE("a browser that connects while its session is starting is relayed once it is ready", "[manager]") {
   TempDir data;
-  auto flags = rfbsim::test::small_session_args();
-  ManagerUnderTest manager(data.path(), flags);
+  ManagerUnderTest manager(data.path(), rfbsim::test::small_session_args());
   // Connect in the same breath as the redirect: the session is (almost always) still starting.
   const std::string token = rfbsim::test::token_from_redirect(manager.start("uid=early&scenario=warehouse"));
   REQUIRE(token.size() == 32);
-  WsRfbBridge bridge(ws_url(manager, token));
+  WsRfbBridge bridge(manager.ws_url(token));
   RfbTestClient client("127.0.0.1", bridge.port());
   CHECK(client.wait_for_updates(1, 20s));
 }
@@ -132,7 +124,7 @@ TEST_CASE("a legacy program that serves raw RFB on a given port can be a session
   const std::string token = rfbsim::test::token_from_redirect(manager.start("uid=legacy-1"));
   REQUIRE(token.size() == 32);
   REQUIRE(manager.wait_for_state(token, "running"));
-  WsRfbBridge bridge(ws_url(manager, token));
+  WsRfbBridge bridge(manager.ws_url(token));
   RfbTestClient client("127.0.0.1", bridge.port());
   REQUIRE(client.wait_for_updates(1, 20s));
   CHECK(client.width() == 640);  // rfbsim_minimal's size
@@ -154,7 +146,7 @@ TEST_CASE("a session that cannot start is marked failed with the program's own w
   REQUIRE(row);
   CHECK(row->exit_status == "exit 2");
   CHECK(row->detail.find("scenario error") != std::string::npos);
-  CHECK(row->ended_at_set);
+  CHECK_FALSE(row->ended_at.empty());
   // The page says it has ended; the same link may try again (a failed start is not a completed session).
   CHECK(manager.get("/s/" + token + "/").status == 410);
   CHECK(manager.start("uid=bad-goal&scenario=lab&robot_goal=500,500,0").status == 302);
@@ -168,7 +160,7 @@ TEST_CASE("stopping the manager ends every session it started", "[manager]") {
   REQUIRE(manager.wait_for_state(a, "running"));
   REQUIRE(manager.wait_for_state(b, "running"));
   const auto before = manager.index_rows();
-  WsRfbBridge bridge(ws_url(manager, a));
+  WsRfbBridge bridge(manager.ws_url(a));
   RfbTestClient client("127.0.0.1", bridge.port());
   REQUIRE(client.wait_for_updates(1, 20s));
 
@@ -178,7 +170,7 @@ TEST_CASE("stopping the manager ends every session it started", "[manager]") {
   for (const auto& row : before) CHECK_FALSE(rfbsim::test::process_exists(static_cast<pid_t>(row.pid)));
   for (const auto& row : manager.index_rows()) {
     CHECK(row.state == "shutdown");
-    CHECK(row.ended_at_set);
+    CHECK_FALSE(row.ended_at.empty());
   }
   REQUIRE(bridge.wait_last_finished(5s));
   CHECK(bridge.last_close_code() == 1001);

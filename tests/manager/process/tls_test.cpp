@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sys/wait.h>
 
-#include "manager_fixture.hpp"
+#include "manager_process.hpp"
 #include "rfb_test_client.hpp"
 #include "tls_test_cert.hpp"
 #include "ws_rfb_bridge.hpp"
@@ -21,10 +21,9 @@ using rfbsim::test::token_from_redirect;
 TEST_CASE("https and wss with a certificate made for the test", "[manager][tls]") {
   TempDir data;
   const auto certificate = rfbsim::test::make_test_certificate(data.path());
-  auto flags = rfbsim::test::small_session_args();
-  flags.insert(flags.end(), {"--tls-certificate", certificate.cert_pem.string(), "--tls-private-key",
-                             certificate.key_pem.string()});
-  ManagerUnderTest manager(data.path() / "data", flags);
+  ManagerUnderTest manager(data.path() / "data",
+                           rfbsim::test::with_small_sessions({"--tls-certificate", certificate.cert_pem.string(),
+                                                              "--tls-private-key", certificate.key_pem.string()}));
 
   CHECK(manager.get("/healthz", {}, true).status == 200);
   CHECK(manager.get("/healthz", {}, false).status == -1);  // plain HTTP on a TLS port gets no answer
@@ -37,7 +36,7 @@ TEST_CASE("https and wss with a certificate made for the test", "[manager][tls]"
   rfbsim::test::WsRfbBridgeOptions options;
   options.verify_certificate = true;
   options.ca_file = certificate.cert_pem.string();
-  WsRfbBridge bridge("wss://127.0.0.1:" + std::to_string(manager.port()) + "/s/" + token + "/ws", options);
+  WsRfbBridge bridge(manager.ws_url(token, true), options);
   RfbTestClient client("127.0.0.1", bridge.port());
   CHECK(client.wait_for_updates(1, 20s));
   CHECK(manager.wait_for_state(token, "running", 5s, true));

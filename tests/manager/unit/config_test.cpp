@@ -54,7 +54,7 @@ TEST_CASE("the defaults") {
   CHECK(c.host_id.empty());
   CHECK(c.web_root.empty());
   CHECK(c.public_url.empty());
-  CHECK(c.limits.address_space_mb == 8192);
+  CHECK(c.limits.address_space_mb == rfbsim::manager::kDefaultAddressSpaceMb);  // 8192, or 0 under ASan
   CHECK(c.limits.open_files == 1024);
   CHECK(c.limits.cpu_time_factor == 2.0);
   CHECK(c.limits.cpu_slack == seconds(60));
@@ -398,4 +398,12 @@ TEST_CASE("settings that cannot work together") {
           "session_kind rfb needs {port} in session_args, where the program is told its port");
     CHECK(args_error({"--session-kind", "rfb", "--session-arg", "{port}"}).empty());
   }
+}
+
+TEST_CASE("sessions get an 8 GiB address-space limit by default, except in AddressSanitizer builds") {
+#if defined(__SANITIZE_ADDRESS__)
+  CHECK(rfbsim::manager::kDefaultAddressSpaceMb == 0);
+#else
+  CHECK(rfbsim::manager::kDefaultAddressSpaceMb == 8192);
+#endif
 }

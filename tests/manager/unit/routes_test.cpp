@@ -145,3 +145,9 @@ TEST_CASE("a token is 32 lower-case hex digits") {
   CHECK_FALSE(is_token("0123456789abcdeg0123456789abcdef"));
   CHECK_FALSE(is_token("0123456789abcde-0123456789abcdef"));
 }
+
+TEST_CASE("a path asked for with the wrong method says which methods it takes") {
+  CHECK(std::string(route_request("POST", "/start").allowed) == "GET, HEAD");
+  CHECK(std::string(route_request("GET", "/api/sessions/3/end").allowed) == "POST");
+  CHECK(std::string(route_request("DELETE", "/s/" + kToken + "/").allowed) == "GET, HEAD");
+}
