@@ -16,6 +16,7 @@
 #include "query.hpp"
 #include "relay.hpp"
 #include "routes.hpp"
+#include "session_views.hpp"
 #include "start_request.hpp"
 #include "static_files.hpp"
 #include "web_policy.hpp"
@@ -38,18 +39,12 @@ constexpr int kAdminRecentSessions = 200;
 // browser the connection was lost.
 constexpr auto kUpstreamLostGrace = std::chrono::milliseconds(300);
 
-// What a browser is told when its session closes, by the session's final (or coming) state.
-std::pair<CloseCode, std::string> close_for(SessionState state) {
-  namespace status = websocketpp::close::status;
-  switch (state) {
-    case SessionState::kFinished: return {status::normal, "session finished"};
-    case SessionState::kExpired: return {status::going_away, "session expired"};
-    case SessionState::kIdle: return {status::going_away, "session ended after being idle"};
-    case SessionState::kEnded: return {status::going_away, "session ended by the researcher"};
-    case SessionState::kShutdown: return {status::going_away, "server shutting down"};
-    case SessionState::kFailed: return {status::internal_endpoint_error, "the simulator could not start"};
-    default: return {status::internal_endpoint_error, "the simulator stopped unexpectedly"};
-  }
+// websocketpp's close call for a session's notice.
+template <typename Connection>
+void close_with(Connection& connection, SessionState state) {
+  const CloseNotice notice = close_notice(state);
+  websocketpp::lib::error_code ec;
+  connection.close(static_cast<CloseCode>(notice.code), notice.reason, ec);
 }
 
 std::string read_file(const std::filesystem::path& path, bool& ok) {
@@ -59,19 +54,6 @@ std::string read_file(const std::filesystem::path& path, bool& ok) {
   std::ostringstream content;
   content << in.rdbuf();
   return content.str();
-}
-
-std::string session_json(const Session& s, bool include_token) {
-  const auto time = [](const std::optional<WallTime>& t) { return t ? "\"" + iso_utc(*t) + "\"" : std::string("null"); };
-  std::string json = "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"scenario\":\"" +
-                     json_escape(s.scenario) + "\",\"seed\":\"" + std::to_string(s.seed) + "\",\"state\":\"" +
-                     state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"exit_status\":\"" +
-                     json_escape(s.exit_status) + "\",\"created_at\":\"" + iso_utc(s.created) +
-                     "\",\"ready_at\":" + time(s.ready_at) + ",\"ended_at\":" + time(s.ended_at) +
-                     ",\"data_path\":\"" + json_escape(s.data_path) + "\",\"params\":" +
-                     (s.params_json.empty() ? "{}" : s.params_json);
-  if (include_token) json += ",\"token\":\"" + s.token + "\"";
-  return json + "}";
 }
 
 template <typename WsConfig>
@@ -153,10 +135,10 @@ class FrontendImpl final : public Frontend, public SessionListener {
   }
 
   void session_closing(const Session& session) override {
-    const auto [code, reason] = close_for(session.state == SessionState::kEnding ? session.end_as : session.state);
+    const CloseNotice notice = close_notice(coming_state(session));
     auto relays = relays_;  // closing may call back into forget_websocket
     for (auto& [hdl, relay] : relays) {
-      if (relay->session_id() == session.id) relay->close(code, reason);
+      if (relay->session_id() == session.id) relay->close(notice);
     }
   }
 
@@ -170,6 +152,9 @@ class FrontendImpl final : public Frontend, public SessionListener {
     con->set_body(body);
     con->replace_header("Content-Type", content_type);
     con->replace_header("Cache-Control", "no-store");
+    // websocketpp closes the connection after every plain HTTP response; say so, or a client that keeps
+    // connections alive (Node's fetch, some proxies) may send its next request down a closed socket.
+    con->replace_header("Connection", "close");
     for (const auto& [name, value] : extra) con->replace_header(name, value);
   }
 
@@ -199,17 +184,30 @@ class FrontendImpl final : public Frontend, public SessionListener {
     switch (route.kind) {
       case RouteKind::kHome: respond_page(con, 200, home_page()); return;
       case RouteKind::kStart: handle_start(con, route); return;
-      case RouteKind::kSessionFile: handle_session_file(con, route); return;
+      case RouteKind::kSessionFile: handle_session_file(con, route, page_headers(config_.frame_origins)); return;
       case RouteKind::kSessionStatus: handle_session_status(con, route); return;
       case RouteKind::kSessionSocket:
         refuse(con, 400, Rejection::kBadRequest, "WebSocket only", "This address takes WebSocket connections only.");
+        return;
+      // The researcher's view of a session: the participant's page behind the admin token, framed by no
+      // survey (a survey page must not show a researcher's view), its socket relayed view-only.
+      case RouteKind::kWatchFile:
+        if (admin_allowed(con)) handle_session_file(con, route, page_headers({}));
+        return;
+      case RouteKind::kWatchStatus:
+        if (admin_allowed(con)) handle_session_status(con, route);
+        return;
+      case RouteKind::kWatchSocket:
+        if (admin_allowed(con)) {
+          refuse(con, 400, Rejection::kBadRequest, "WebSocket only", "This address takes WebSocket connections only.");
+        }
         return;
       case RouteKind::kHealth:
         respond_json(con, 200, "{\"status\":\"ok\",\"live_sessions\":" + std::to_string(supervisor_.table().size()) +
                                    ",\"capacity\":" + std::to_string(config_.max_sessions) + "}");
         return;
       case RouteKind::kMetrics:
-        respond(con, 200, metrics_.render(supervisor_.counts_by_state(), config_.max_sessions, static_cast<int>(relays_.size())),
+        respond(con, 200, metrics_.render(supervisor_.counts_by_state(), config_.max_sessions, relay_counts()),
                 "text/plain; version=0.0.4; charset=utf-8");
         return;
       case RouteKind::kAdminPage: handle_admin_page(con, route); return;
@@ -269,7 +267,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
     }
   }
 
-  void handle_session_file(const ConnectionPtr& con, const Route& route) {
+  // A file of a session's page (`headers`: who may frame it), while the session is live.
+  void handle_session_file(const ConnectionPtr& con, const Route& route, const Headers& headers) {
     const auto session = supervisor_.find(route.token);
     if (!session) {
       refuse(con, 404, Rejection::kUnknownSession, "Session not found",
@@ -278,8 +277,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
     }
     if (!is_live(session->state) || session->state == SessionState::kEnding) {
       metrics_.count_rejection(Rejection::kEndedSession);
-      respond_page(con, 410, session_ended_page(state_name(session->state == SessionState::kEnding ? session->end_as
-                                                                                                 : session->state)));
+      respond_page(con, 410, session_ended_page(state_name(coming_state(*session))));
       return;
     }
     const auto path = detail::resolve_static_path(web_root_, "/" + route.file);
@@ -289,7 +287,6 @@ class FrontendImpl final : public Frontend, public SessionListener {
       refuse(con, 404, Rejection::kBadRequest, "Not found", "There is nothing at this address.");
       return;
     }
-    Headers headers = page_headers(config_.frame_origins);
     respond(con, 200, body, std::string(detail::mime_type_for(*path)), headers);
   }
 
@@ -300,13 +297,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
       respond_json(con, 404, "{\"error\":\"unknown session\"}");
       return;
     }
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::system_clock::now() - session->created).count();
-    char seconds[32];
-    std::snprintf(seconds, sizeof seconds, "%.3f", elapsed);
-    const SessionState shown = session->state == SessionState::kEnding ? session->end_as : session->state;
-    respond_json(con, 200, std::string("{\"state\":\"") + state_name(session->state) + "\",\"ends_as\":\"" +
-                               state_name(shown) + "\",\"elapsed_s\":" + seconds + "}");
+    respond_json(con, 200, status_json(*session, std::chrono::system_clock::now()));
   }
 
   bool admin_allowed(const ConnectionPtr& con) {
@@ -396,11 +387,24 @@ class FrontendImpl final : public Frontend, public SessionListener {
     const std::string& target = con->get_resource();
     if (target.size() > kMaxTarget) return reject_websocket(con, 414, Rejection::kBadRequest, "address too long");
     const Route route = route_request(con->get_request().get_method(), target);
-    if (route.kind != RouteKind::kSessionSocket) {
+    if (route.kind != RouteKind::kSessionSocket && route.kind != RouteKind::kWatchSocket) {
       return reject_websocket(con, 404, Rejection::kBadRequest, "no WebSocket at this address");
     }
+    const bool watch = route.kind == RouteKind::kWatchSocket;
+    if (watch) {
+      // The browser resends the admin page's Basic credentials on this handshake by itself, to any page that
+      // opens the socket: the Origin check below (manager's own origin only) is what keeps other sites out.
+      if (config_.admin_token.empty()) {
+        return reject_websocket(con, 404, Rejection::kUnauthorized, "administration is not enabled");
+      }
+      if (!admin_authorized(con->get_request_header("Authorization"), config_.admin_token)) {
+        con->replace_header("WWW-Authenticate", "Basic realm=\"rfbsim admin\", charset=\"UTF-8\"");
+        return reject_websocket(con, 401, Rejection::kUnauthorized, "the admin token is needed");
+      }
+    }
+    // A watcher's page is never framed by a survey, so no survey origin may open its socket either.
     if (!websocket_origin_allowed(con->get_request_header("Origin"), con->get_request_header("Host"),
-                                  config_.frame_origins)) {
+                                  watch ? std::vector<std::string>{} : config_.frame_origins)) {
       return reject_websocket(con, 403, Rejection::kForbiddenOrigin, "this origin may not connect");
     }
     Session* session = supervisor_.table().by_token(route.token);
@@ -419,44 +423,47 @@ class FrontendImpl final : public Frontend, public SessionListener {
         break;
       }
     }
-    pending_tokens_[con->get_handle()] = route.token;
+    pending_[con->get_handle()] = Pending{route.token, watch ? RelayKind::kWatch : RelayKind::kParticipant};
     return true;
   }
 
   void open_websocket(connection_hdl hdl) {
-    const auto token = pending_tokens_.find(hdl);
-    if (token == pending_tokens_.end()) return;
-    const std::string session_token = token->second;
-    pending_tokens_.erase(token);
+    const auto pending = pending_.find(hdl);
+    if (pending == pending_.end()) return;
+    const std::string session_token = pending->second.token;
+    const RelayKind kind = pending->second.kind;
+    pending_.erase(pending);
     auto con = server_.get_con_from_hdl(hdl);
     Session* session = supervisor_.table().by_token(session_token);
     if (session == nullptr || session->state == SessionState::kEnding) {
       // It ended between the handshake's check and now: say how, as for any other ending.
       const auto ended = supervisor_.find(session_token);
-      const SessionState state = !ended ? SessionState::kCrashed
-                                 : ended->state == SessionState::kEnding ? ended->end_as
-                                                                         : ended->state;
-      const auto [code, reason] = close_for(state);
-      websocketpp::lib::error_code ec;
-      con->close(code, reason, ec);
+      close_with(*con, ended ? coming_state(*ended) : SessionState::kCrashed);
       return;
     }
-    auto relay = std::make_shared<RelayT>(server_, hdl, session->id, session->token, metrics_,
+    auto relay = std::make_shared<RelayT>(server_, hdl, session->id, session->token, kind, metrics_,
                                           [this](RelayT& lost) { upstream_lost(lost); });
     relays_[hdl] = relay;
-    metrics_.count_relay_open();
-    supervisor_.client_connected(session->id);
+    metrics_.count_relay_open(kind);
+    // Only the participant counts as connected: a researcher watching must not keep an idle session alive.
+    if (kind == RelayKind::kParticipant) supervisor_.client_connected(session->id);
     if (session->state == SessionState::kRunning) relay->connect(session->port);
   }
 
   void forget_websocket(connection_hdl hdl) {
-    pending_tokens_.erase(hdl);
+    pending_.erase(hdl);
     const auto it = relays_.find(hdl);
     if (it == relays_.end()) return;
     const auto relay = it->second;
     relays_.erase(it);
     relay->browser_gone();
-    supervisor_.client_disconnected(relay->session_id());
+    if (relay->kind() == RelayKind::kParticipant) supervisor_.client_disconnected(relay->session_id());
+  }
+
+  RelayCounts relay_counts() const {
+    RelayCounts counts;
+    for (const auto& [hdl, relay] : relays_) ++(relay->kind() == RelayKind::kWatch ? counts.watch : counts.participant);
+    return counts;
   }
 
   // The session's socket closed under a relay. Usually the process is ending or gone, and its exit will
@@ -469,9 +476,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
       if (!alive) return;
       const auto session = supervisor_.find(alive->token());
       if (session && session->state != SessionState::kRunning) {
-        const auto [code, reason] =
-            close_for(session->state == SessionState::kEnding ? session->end_as : session->state);
-        alive->close(code, reason);
+        alive->close(close_notice(coming_state(*session)));
       } else {
         alive->close(websocketpp::close::status::internal_endpoint_error, "lost the connection to the simulator");
       }
@@ -486,7 +491,12 @@ class FrontendImpl final : public Frontend, public SessionListener {
   bool tls_;
   Server server_;
   std::map<connection_hdl, std::shared_ptr<RelayT>, std::owner_less<connection_hdl>> relays_;
-  std::map<connection_hdl, std::string, std::owner_less<connection_hdl>> pending_tokens_;  // validated, not open
+  // A WebSocket handshake that passed validation and has not opened yet: its session and kind.
+  struct Pending {
+    std::string token;
+    RelayKind kind = RelayKind::kParticipant;
+  };
+  std::map<connection_hdl, Pending, std::owner_less<connection_hdl>> pending_;
 };
 
 // TLS settings for the public port: TLS 1.2 and later, the certificate chain and key loaded once, now,

@@ -40,6 +40,8 @@ const char* rejection_name(Rejection reason) {
   return "other";
 }
 
+const char* relay_kind_name(RelayKind kind) { return kind == RelayKind::kWatch ? "watch" : "participant"; }
+
 void Metrics::observe_startup(double seconds) {
   ++startup_count_;
   startup_sum_ += seconds;
@@ -54,7 +56,7 @@ std::uint64_t Metrics::rejections(Rejection reason) const {
 }
 
 std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions_by_state, int capacity,
-                            int relays) const {
+                            RelayCounts relays) const {
   std::string out;
   header(out, "rfbsim_sessions", "gauge", "Sessions by state (live states now; ended states in the whole index).");
   for (const SessionState state : kAllStates) {
@@ -77,10 +79,19 @@ std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions
   header(out, "rfbsim_relay_bytes_total", "counter", "Bytes relayed between browsers and sessions.");
   out += "rfbsim_relay_bytes_total{direction=\"to_client\"} " + std::to_string(bytes_to_client_) + "\n";
   out += "rfbsim_relay_bytes_total{direction=\"to_session\"} " + std::to_string(bytes_to_session_) + "\n";
-  header(out, "rfbsim_relay_connections", "gauge", "WebSocket relays open now.");
-  out += "rfbsim_relay_connections " + std::to_string(relays) + "\n";
-  header(out, "rfbsim_relay_connections_total", "counter", "WebSocket relays opened since the manager started.");
-  out += "rfbsim_relay_connections_total " + std::to_string(relays_opened_) + "\n";
+  // By kind: a researcher watching is no participant, and dashboards should not count one as such.
+  constexpr RelayKind kKinds[] = {RelayKind::kParticipant, RelayKind::kWatch};
+  header(out, "rfbsim_relay_connections", "gauge", "WebSocket relays open now, by kind (participant or watch).");
+  for (const RelayKind kind : kKinds) {
+    out += std::string("rfbsim_relay_connections{kind=\"") + relay_kind_name(kind) + "\"} " +
+           std::to_string(kind == RelayKind::kWatch ? relays.watch : relays.participant) + "\n";
+  }
+  header(out, "rfbsim_relay_connections_total", "counter",
+         "WebSocket relays opened since the manager started, by kind (participant or watch).");
+  for (const RelayKind kind : kKinds) {
+    out += std::string("rfbsim_relay_connections_total{kind=\"") + relay_kind_name(kind) + "\"} " +
+           std::to_string(relays_opened_[kind == RelayKind::kWatch ? 1 : 0]) + "\n";
+  }
   header(out, "rfbsim_rejections_total", "counter", "Requests turned away, by reason.");
   for (const Rejection reason : kAllRejections) {
     out += std::string("rfbsim_rejections_total{reason=\"") + rejection_name(reason) + "\"} " +

@@ -27,6 +27,20 @@ enum class Rejection {
 
 const char* rejection_name(Rejection reason);
 
+/// Who a WebSocket relay serves; each a label value of rfbsim_relay_connections and _total.
+enum class RelayKind {
+  kParticipant,  ///< /s/<token>/ws: the participant, with input
+  kWatch,        ///< /admin/watch/<token>/ws: a researcher, view-only
+};
+
+const char* relay_kind_name(RelayKind kind);
+
+/// WebSocket relays open now, by kind.
+struct RelayCounts {
+  int participant = 0;
+  int watch = 0;
+};
+
 /// Counters since the manager started; the session gauges are read from the table when rendered.
 class Metrics {
  public:
@@ -39,7 +53,7 @@ class Metrics {
   void observe_startup(double seconds);
   void add_bytes_to_client(std::uint64_t bytes) { bytes_to_client_ += bytes; }
   void add_bytes_to_session(std::uint64_t bytes) { bytes_to_session_ += bytes; }
-  void count_relay_open() { ++relays_opened_; }
+  void count_relay_open(RelayKind kind) { ++relays_opened_[kind == RelayKind::kWatch ? 1 : 0]; }
 
   [[nodiscard]] std::uint64_t starts() const { return starts_; }
   [[nodiscard]] std::uint64_t rejections(Rejection reason) const;
@@ -48,7 +62,7 @@ class Metrics {
   /// The exposition text. `sessions_by_state`: live sessions by state now, and ended ones by state over
   /// the whole index; `relays`: WebSocket relays open now.
   [[nodiscard]] std::string render(const std::map<SessionState, std::int64_t>& sessions_by_state, int capacity,
-                                   int relays) const;
+                                   RelayCounts relays) const;
 
  private:
   std::uint64_t starts_ = 0;
@@ -58,7 +72,7 @@ class Metrics {
   double startup_sum_ = 0;
   std::uint64_t bytes_to_client_ = 0;
   std::uint64_t bytes_to_session_ = 0;
-  std::uint64_t relays_opened_ = 0;
+  std::array<std::uint64_t, 2> relays_opened_{};  // participant, watch
 };
 
 }  // namespace rfbsim::manager

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Relay: one browser WebSocket carried to one session's loopback port as raw RFB, byte for byte.
+// Relay: one browser WebSocket carried to one session's loopback port as raw RFB, byte for byte; a watch
+// relay (a researcher's view) passes the browser's bytes through an RfbInputFilter first, so that a watcher
+// sees the session but cannot steer it.
 //
 // Flow control keeps a slow browser from growing the manager's memory: while more than kMaxBuffered bytes
 // wait in the WebSocket's send buffer, the relay stops reading from the session, so TCP pushes back and
@@ -24,6 +26,8 @@
 #include <websocketpp/frame.hpp>
 
 #include "metrics.hpp"
+#include "rfb_input_filter.hpp"
+#include "session_views.hpp"
 
 namespace rfbsim::manager {
 
@@ -37,12 +41,14 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   /// Called once when the session side closes or fails (not when close() was called first).
   using UpstreamLost = std::function<void(Relay&)>;
 
+  /// `kind` kWatch drops the browser's input (RfbInputFilter) and closes it on bytes that cannot be framed.
   Relay(Server& server, websocketpp::connection_hdl browser, std::int64_t session_id, std::string token,
-        Metrics& metrics, UpstreamLost on_upstream_lost)
+        RelayKind kind, Metrics& metrics, UpstreamLost on_upstream_lost)
       : server_(server),
         browser_(std::move(browser)),
         session_id_(session_id),
         token_(std::move(token)),
+        kind_(kind),
         metrics_(metrics),
         on_upstream_lost_(std::move(on_upstream_lost)),
         upstream_(server.get_io_service()),
@@ -50,6 +56,7 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
 
   [[nodiscard]] std::int64_t session_id() const { return session_id_; }
   [[nodiscard]] const std::string& token() const { return token_; }
+  [[nodiscard]] RelayKind kind() const { return kind_; }
   [[nodiscard]] bool connecting_or_connected() const { return connect_started_; }
 
   /// Connects to the session's port and starts relaying (browser bytes received so far go first).
@@ -75,6 +82,14 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   /// A binary message from the browser: raw RFB bytes for the session.
   void from_browser(std::string payload) {
     if (closed_) return;
+    if (kind_ == RelayKind::kWatch) {
+      payload = filter_.forward(payload);
+      if (filter_.failed()) {
+        close(websocketpp::close::status::policy_violation, filter_.failure());
+        return;
+      }
+      if (payload.empty()) return;  // only input, all dropped
+    }
     pending_bytes_ += payload.size();
     if (pending_bytes_ > kMaxPending) {
       close(websocketpp::close::status::message_too_big, "too much input");
@@ -94,6 +109,11 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     websocketpp::lib::error_code ec;
     auto connection = server_.get_con_from_hdl(browser_, ec);
     if (!ec && connection->get_state() == websocketpp::session::state::open) connection->close(code, reason, ec);
+  }
+
+  /// Closes both sides with a session's close notice.
+  void close(const CloseNotice& notice) {
+    close(static_cast<websocketpp::close::status::value>(notice.code), notice.reason);
   }
 
   /// The browser's side is gone: drop the session's socket too.
@@ -167,6 +187,8 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   websocketpp::connection_hdl browser_;
   std::int64_t session_id_;
   std::string token_;
+  RelayKind kind_;
+  RfbInputFilter filter_;  // used by watch relays only
   Metrics& metrics_;
   UpstreamLost on_upstream_lost_;
   boost::asio::ip::tcp::socket upstream_;

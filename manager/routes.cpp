@@ -20,6 +20,24 @@ Route with_method(Route route, std::string_view method, std::string_view wanted)
   return route;
 }
 
+// <token>/ and what lies below it, after /s/ or /admin/watch/: the page's files, its status and its socket.
+Route token_route(Route route, std::string_view method, std::string_view rest, RouteKind file, RouteKind status,
+                  RouteKind socket) {
+  const std::size_t slash = rest.find('/');
+  if (slash == std::string_view::npos || !is_token(rest.substr(0, slash))) return route;
+  route.token = std::string(rest.substr(0, slash));
+  const std::string_view below = rest.substr(slash + 1);
+  if (below == "ws") {
+    route.kind = socket;
+  } else if (below == "status") {
+    route.kind = status;
+  } else {
+    route.kind = file;
+    route.file = std::string(below);
+  }
+  return with_method(route, method, "GET");
+}
+
 }  // namespace
 
 bool is_token(std::string_view text) {
@@ -54,6 +72,12 @@ Route route_request(std::string_view method, std::string_view target) {
     route.kind = RouteKind::kAdminPage;
     return with_method(route, method, "GET");
   }
+  // The researcher's view-only copy of a session's page; before /admin/'s own files, which it lies among.
+  constexpr std::string_view kWatchPrefix = "/admin/watch/";
+  if (path.rfind(kWatchPrefix, 0) == 0) {
+    return token_route(route, method, path.substr(kWatchPrefix.size()), RouteKind::kWatchFile,
+                       RouteKind::kWatchStatus, RouteKind::kWatchSocket);
+  }
   if (path.rfind("/admin/", 0) == 0) {
     route.kind = RouteKind::kAdminPage;
     route.file = std::string(path.substr(7));
@@ -78,20 +102,8 @@ Route route_request(std::string_view method, std::string_view target) {
   // /s/<token>/ and what lies below it.
   constexpr std::string_view kSessionPrefix = "/s/";
   if (path.rfind(kSessionPrefix, 0) == 0) {
-    const std::string_view rest = path.substr(kSessionPrefix.size());
-    const std::size_t slash = rest.find('/');
-    if (slash == std::string_view::npos || !is_token(rest.substr(0, slash))) return route;
-    route.token = std::string(rest.substr(0, slash));
-    const std::string_view below = rest.substr(slash + 1);
-    if (below == "ws") {
-      route.kind = RouteKind::kSessionSocket;
-    } else if (below == "status") {
-      route.kind = RouteKind::kSessionStatus;
-    } else {
-      route.kind = RouteKind::kSessionFile;
-      route.file = std::string(below);
-    }
-    return with_method(route, method, "GET");
+    return token_route(route, method, path.substr(kSessionPrefix.size()), RouteKind::kSessionFile,
+                       RouteKind::kSessionStatus, RouteKind::kSessionSocket);
   }
   return route;
 }

@@ -17,6 +17,9 @@ enum class RouteKind {
   kHealth,         ///< GET /healthz
   kMetrics,        ///< GET /metrics
   kAdminPage,      ///< GET /admin (and its script)
+  kWatchFile,      ///< GET /admin/watch/<token>/<file>: the participant page, for a researcher to watch
+  kWatchStatus,    ///< GET /admin/watch/<token>/status: as kSessionStatus
+  kWatchSocket,    ///< GET /admin/watch/<token>/ws (WebSocket upgrade): the view-only relay
   kApiSessions,    ///< GET /api/sessions
   kApiEndSession,  ///< POST /api/sessions/<id>/end
   kNotFound,
@@ -26,8 +29,9 @@ enum class RouteKind {
 /// A routed request: what it is for and the parts of the path it names.
 struct Route {
   RouteKind kind = RouteKind::kNotFound;
-  std::string token;      ///< kSession*: 32 lower-case hex digits (checked)
-  std::string file;       ///< kSessionFile, kAdminPage: the rest of the path after the prefix (not decoded)
+  std::string token;      ///< kSession*, kWatch*: 32 lower-case hex digits (checked)
+  std::string file;       ///< kSessionFile, kWatchFile, kAdminPage: the rest of the path after the prefix (not
+                          ///< decoded)
   std::int64_t session_id = 0;  ///< kApiEndSession
   std::string query;      ///< the raw query string (after '?')
   const char* allowed = "GET, HEAD";  ///< kBadMethod: the methods the path takes (an Allow header)

@@ -39,6 +39,10 @@ bool counts_as_completed(SessionState state) {
          state == SessionState::kEnded;
 }
 
+SessionState coming_state(const Session& session) {
+  return session.state == SessionState::kEnding ? session.end_as : session.state;
+}
+
 bool begin_ending(Session& session, SessionState end_as, std::string detail) {
   if (session.state != SessionState::kStarting && session.state != SessionState::kRunning) return false;
   session.end_as = end_as;

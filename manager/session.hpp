@@ -74,6 +74,9 @@ struct Session {
   std::optional<WallTime> ended_at;  ///< the process was gone
 };
 
+/// The state a session has, or while ending the one it will get: what a browser or page is told.
+SessionState coming_state(const Session& session);
+
 /// Moves a starting or running session to ending, to become `end_as` once its process is gone.
 /// Returns false (and changes nothing) if it is not starting or running.
 bool begin_ending(Session& session, SessionState end_as, std::string detail);

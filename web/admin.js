@@ -132,14 +132,16 @@ function syncRows(tbody, sessions, make, update) {
   });
 }
 
-// Live sessions: id, participant, scenario, state, started, age, data folder, Watch and End.
+// Live sessions: id, participant, scenario, state, started, age, data folder, Watch and End. Watch opens the
+// participant's page under /admin/watch/, where sim_manager relays it view-only: the researcher's keys and clicks
+// never reach the session, and watching does not keep an idle session alive.
 function makeLiveRow(session) {
   const row = makeRow(session.id, ['num', '', '', '', 'time', 'num', 'path', 'actions']);
   const actions = row.cells[7];
   const watch = document.createElement('a');
   watch.target = '_blank';
   watch.rel = 'noopener noreferrer';
-  watch.textContent = 'Watch';
+  watch.textContent = 'Watch (view only)';
   const end = document.createElement('button');
   end.type = 'button';
   end.textContent = 'End';
@@ -158,12 +160,12 @@ function updateLiveRow(row, session, now) {
   setText(c[5], formatDuration(millisBetween(session.created_at, now)));
   setText(c[6], session.data_path);
   const [watch, end] = c[7].children;
-  const href = session.token ? `/s/${encodeURIComponent(session.token)}/` : '';
+  const href = session.token ? `/admin/watch/${encodeURIComponent(session.token)}/` : '';
   if (watch.getAttribute('href') !== href) {
     watch.setAttribute('href', href);
   }
   watch.hidden = href === '';
-  watch.setAttribute('aria-label', `Watch session ${session.id} (${session.uid})`);
+  watch.setAttribute('aria-label', `Watch session ${session.id} (${session.uid}), view only`);
   end.setAttribute('aria-label', `End session ${session.id} (${session.uid})`);
   if (session.state === 'ending') {
     end.disabled = true;

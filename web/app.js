@@ -64,6 +64,11 @@ const options = {
 };
 state.options = options;
 
+// A researcher watching from the admin page (/admin/watch/<token>/): the manager drops this page's keys
+// and pointer anyway; here the view is read-only and never invites anyone to walk.
+const watching = window.location.pathname.startsWith('/admin/watch/');
+state.watching = watching;
+
 // ---------------------------------------------------------------------------------------------------------------
 // Addresses, relative to this page so that they work both under sim_manager (/s/<token>/) and from sim_rfb
 // itself (/, where any WebSocket path is accepted and 'status' does not exist).
@@ -205,7 +210,7 @@ function showProgress() {
 // itself not focused).
 function updateFocus() {
   state.focused = canvas !== null && document.hasFocus() && document.activeElement === canvas;
-  ui.hint.hidden = !state.connected || state.focused;
+  ui.hint.hidden = watching || !state.connected || state.focused;
 }
 
 // The panel after a disconnect. `final`: the session is over for good, so there is nothing to reconnect to.
@@ -310,6 +315,7 @@ function connect({ focusWhenConnected = false } = {}) {
   client.resizeSession = false;
   client.focusOnClick = true;
   client.showDotCursor = true;
+  client.viewOnly = watching;
   client.background = '#1e1e1e';
   if (options.quality !== null) {
     client.qualityLevel = options.quality;
@@ -323,7 +329,8 @@ function connect({ focusWhenConnected = false } = {}) {
   if (canvas !== null) {
     canvas.tabIndex = 0;
     canvas.setAttribute('role', 'application');
-    canvas.setAttribute('aria-label', 'Simulator view. Use W, A, S and D to walk.');
+    canvas.setAttribute('aria-label', watching ? 'Simulator view, watched (view only).'
+                                                : 'Simulator view. Use W, A, S and D to walk.');
     canvas.addEventListener('focus', updateFocus);
     canvas.addEventListener('blur', updateFocus);
     watchForFirstPicture(client, canvas);

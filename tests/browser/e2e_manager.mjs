@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Browser end-to-end test of sim_manager: a real Chromium follows participant links, sees the start-up progress
 // and the first picture, walks, reloads, is embedded in a survey (allowed and refused origins), is ended by the
-// researcher through the admin API, and the admin page lists and ends sessions.
+// researcher through the admin API, and the admin page lists sessions, watches one view-only and ends it.
 //
 // Usage: node e2e_manager.mjs SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
 //   SIM_MANAGER    the sim_manager executable to start
@@ -440,9 +440,40 @@ async function main() {
   check(/\brunning\b/.test(row2Text), 'the admin page does not show e2e-2 as running');
   check(/\bended\b/.test(row1Text), 'the admin page does not show e2e-1 as ended');
   check(await adminTab.locator('#live tbody tr').count() === 1, 'the admin page lists more than one live session');
-  const watchHref = await row2.getByRole('link', { name: /Watch/ }).getAttribute('href');
-  check(watchHref === `/s/${token2}/`, `the Watch link goes to ${watchHref}, expected /s/${token2}/`);
+  const watchLink = row2.getByRole('link', { name: /Watch/ });
+  const watchHref = await watchLink.getAttribute('href');
+  check(watchHref === `/admin/watch/${token2}/`,
+        `the Watch link goes to ${watchHref}, expected /admin/watch/${token2}/`);
+  check((await watchLink.innerText()).trim() === 'Watch (view only)',
+        `the Watch link says "${await watchLink.innerText()}", expected "Watch (view only)"`);
   await adminTab.screenshot({ path: path.join(env.artifacts, 'manager_admin.png'), fullPage: true });
+
+  // The researcher watches e2e-2: the participant's page under /admin/watch/ (behind the admin credentials, which
+  // the browser also sends on the WebSocket handshake), showing the picture and the session's state.
+  const watchTab = await context.newPage();
+  recordPage(watchTab, path.join(env.artifacts, 'manager-watch-console.log'));
+  const watchSockets = [];
+  watchTab.on('websocket', (ws) => watchSockets.push(ws.url()));
+  const watchResponse = await watchTab.goto(new URL(watchHref, base).href, { waitUntil: 'load', timeout: 20_000 });
+  check(watchResponse && watchResponse.status() === 200, `GET ${watchHref} answered HTTP ${watchResponse?.status()}`);
+  const watchFirstFrameAt = await waitForFirstFrame(watchTab, 'the watch page of e2e-2');
+  check(watchSockets.length === 1 && new URL(watchSockets[0]).pathname === `/admin/watch/${token2}/ws`,
+        `the watch page's WebSockets went to ${JSON.stringify(watchSockets)}, expected /admin/watch/${token2}/ws`);
+  await poll('the watch page to learn the session state', 5000, 100,
+             async () => (await pageState(watchTab)).sessionState === 'running');
+  // The watch page knows it only watches: no invitation to walk, a read-only view.
+  const watchView = await watchTab.evaluate(() => ({
+    watching: window.rfbsimState.watching,
+    hintHidden: document.getElementById('hint').hidden,
+  }));
+  check(watchView.watching === true && watchView.hintHidden === true,
+        `the watch page should be view only with no walking hint, got ${JSON.stringify(watchView)}`);
+  const metricsText = await (await request('metrics')).text();
+  check(/^rfbsim_relay_connections\{kind="watch"\} 1$/m.test(metricsText),
+        'rfbsim_relay_connections{kind="watch"} is not 1 while the watch page is open');
+  log(`watch page of e2e-2: first picture ${Math.round(watchFirstFrameAt)} ms after its navigation started`);
+  await watchTab.screenshot({ path: path.join(env.artifacts, 'manager_watch.png') });
+  await watchTab.close();
 
   // End from the page: confirm, then e2e-2 moves to the recent table and its iframe says the session ended.
   let confirmText = '';

@@ -100,7 +100,8 @@ TEST_CASE("a browser that vanishes mid-stream costs only its own connection", "[
     REQUIRE(client.wait_for_updates(3, 20s));
     bridge.reset();  // drops the WebSocket without a close handshake, in the middle of the stream
   }
-  REQUIRE(rfbsim::test::eventually([&] { return manager.metric("rfbsim_relay_connections") == 0; }, 10s));
+  REQUIRE(rfbsim::test::eventually(
+      [&] { return manager.metric("rfbsim_relay_connections{kind=\"participant\"}") == 0; }, 10s));
   CHECK(manager.state_of(token) == "running");
   // The participant comes back and is served as before.
   WsRfbBridge bridge(manager.ws_url(token));

@@ -50,7 +50,7 @@ TEST_CASE("a link starts a session, redirects at once, and the first frame arriv
   // The participant page is served under the token, framed only by the manager itself.
   const auto page = manager.get("/s/" + token + "/");
   CHECK(page.status == 200);
-  CHECK(page.body.find("app.js") != std::string::npos);
+  CHECK(page.body.find("app.bundle.js") != std::string::npos);
   CHECK(page.headers.at("content-security-policy") == "frame-ancestors 'self'");
   CHECK(page.headers.at("cache-control") == "no-store");
   CHECK(page.headers.at("referrer-policy") == "no-referrer");

@@ -7,6 +7,8 @@
 
 using rfbsim::manager::Metrics;
 using rfbsim::manager::Rejection;
+using rfbsim::manager::RelayCounts;
+using rfbsim::manager::RelayKind;
 using rfbsim::manager::rejection_name;
 using rfbsim::manager::SessionState;
 
@@ -30,20 +32,22 @@ bool has_line(const std::string& text, const std::string& line) {
 
 TEST_CASE("a new Metrics renders every series at zero") {
   const Metrics metrics;
-  const std::string text = metrics.render({}, 4, 0);
+  const std::string text = metrics.render({}, 4, {});
   CHECK(text.back() == '\n');
   CHECK(has_line(text, "rfbsim_session_capacity 4"));
   CHECK(has_line(text, "rfbsim_session_starts_total 0"));
   CHECK(has_line(text, "rfbsim_session_startup_seconds_count 0"));
   CHECK(has_line(text, "rfbsim_session_startup_seconds_sum 0"));
-  CHECK(has_line(text, "rfbsim_relay_connections 0"));
-  CHECK(has_line(text, "rfbsim_relay_connections_total 0"));
+  CHECK(has_line(text, "rfbsim_relay_connections{kind=\"participant\"} 0"));
+  CHECK(has_line(text, "rfbsim_relay_connections{kind=\"watch\"} 0"));
+  CHECK(has_line(text, "rfbsim_relay_connections_total{kind=\"participant\"} 0"));
+  CHECK(has_line(text, "rfbsim_relay_connections_total{kind=\"watch\"} 0"));
   CHECK(has_line(text, "rfbsim_relay_bytes_total{direction=\"to_client\"} 0"));
   CHECK(has_line(text, "rfbsim_relay_bytes_total{direction=\"to_session\"} 0"));
 }
 
 TEST_CASE("every series has its HELP and TYPE") {
-  const std::string text = Metrics().render({}, 1, 0);
+  const std::string text = Metrics().render({}, 1, {});
   CHECK(lines_starting(text, "# TYPE ") == std::vector<std::string>{
                                                "# TYPE rfbsim_sessions gauge",
                                                "# TYPE rfbsim_session_capacity gauge",
@@ -60,7 +64,7 @@ TEST_CASE("every series has its HELP and TYPE") {
 TEST_CASE("sessions are listed for every state, zero included") {
   const Metrics metrics;
   const std::string text =
-      metrics.render({{SessionState::kRunning, 2}, {SessionState::kFinished, 17}, {SessionState::kCrashed, 1}}, 4, 0);
+      metrics.render({{SessionState::kRunning, 2}, {SessionState::kFinished, 17}, {SessionState::kCrashed, 1}}, 4, {});
   CHECK(lines_starting(text, "rfbsim_sessions{") == std::vector<std::string>{
                                                         "rfbsim_sessions{state=\"starting\"} 0",
                                                         "rfbsim_sessions{state=\"running\"} 2",
@@ -80,7 +84,7 @@ TEST_CASE("the start-up histogram's buckets are cumulative") {
   Metrics metrics;
   metrics.observe_startup(0.15);
   metrics.observe_startup(0.6);
-  const std::string text = metrics.render({}, 4, 0);
+  const std::string text = metrics.render({}, 4, {});
   CHECK(lines_starting(text, "rfbsim_session_startup_seconds") == std::vector<std::string>{
             "rfbsim_session_startup_seconds_bucket{le=\"0.1\"} 0",
             "rfbsim_session_startup_seconds_bucket{le=\"0.2\"} 1",
@@ -102,7 +106,7 @@ TEST_CASE("a start-up time on a bucket's bound counts in that bucket, one beyond
   Metrics metrics;
   metrics.observe_startup(0.1);
   metrics.observe_startup(31);
-  const std::string text = metrics.render({}, 4, 0);
+  const std::string text = metrics.render({}, 4, {});
   CHECK(has_line(text, "rfbsim_session_startup_seconds_bucket{le=\"0.1\"} 1"));
   CHECK(has_line(text, "rfbsim_session_startup_seconds_bucket{le=\"30\"} 1"));
   CHECK(has_line(text, "rfbsim_session_startup_seconds_bucket{le=\"+Inf\"} 2"));
@@ -117,16 +121,21 @@ TEST_CASE("counters count") {
   metrics.add_bytes_to_client(1000);
   metrics.add_bytes_to_client(24);
   metrics.add_bytes_to_session(5);
-  metrics.count_relay_open();
+  metrics.count_relay_open(RelayKind::kParticipant);
+  metrics.count_relay_open(RelayKind::kWatch);
+  metrics.count_relay_open(RelayKind::kWatch);
   CHECK(metrics.starts() == 3);
   CHECK(metrics.bytes_to_client() == 1024);
-  const std::string text = metrics.render({}, 8, 1);
+  const std::string text = metrics.render({}, 8, RelayCounts{1, 2});
   CHECK(has_line(text, "rfbsim_session_starts_total 3"));
   CHECK(has_line(text, "rfbsim_session_capacity 8"));
   CHECK(has_line(text, "rfbsim_relay_bytes_total{direction=\"to_client\"} 1024"));
   CHECK(has_line(text, "rfbsim_relay_bytes_total{direction=\"to_session\"} 5"));
-  CHECK(has_line(text, "rfbsim_relay_connections 1"));
-  CHECK(has_line(text, "rfbsim_relay_connections_total 1"));
+  // A researcher watching is counted apart from participants.
+  CHECK(has_line(text, "rfbsim_relay_connections{kind=\"participant\"} 1"));
+  CHECK(has_line(text, "rfbsim_relay_connections{kind=\"watch\"} 2"));
+  CHECK(has_line(text, "rfbsim_relay_connections_total{kind=\"participant\"} 1"));
+  CHECK(has_line(text, "rfbsim_relay_connections_total{kind=\"watch\"} 2"));
 }
 
 TEST_CASE("rejections are counted by reason and every reason is listed") {
@@ -138,7 +147,7 @@ TEST_CASE("rejections are counted by reason and every reason is listed") {
   CHECK(metrics.rejections(Rejection::kBusy) == 2);
   CHECK(metrics.rejections(Rejection::kBadSignature) == 1);
   CHECK(metrics.rejections(Rejection::kUnauthorized) == 0);
-  CHECK(lines_starting(metrics.render({}, 4, 0), "rfbsim_rejections_total{") == std::vector<std::string>{
+  CHECK(lines_starting(metrics.render({}, 4, {}), "rfbsim_rejections_total{") == std::vector<std::string>{
             "rfbsim_rejections_total{reason=\"busy\"} 2",
             "rfbsim_rejections_total{reason=\"bad_request\"} 0",
             "rfbsim_rejections_total{reason=\"bad_signature\"} 1",

@@ -151,3 +151,53 @@ TEST_CASE("a path asked for with the wrong method says which methods it takes") 
   CHECK(std::string(route_request("GET", "/api/sessions/3/end").allowed) == "POST");
   CHECK(std::string(route_request("DELETE", "/s/" + kToken + "/").allowed) == "GET, HEAD");
 }
+
+TEST_CASE("watch paths carry a token and what lies below it, like session paths") {
+  SECTION("the page") {
+    const auto route = route_request("GET", "/admin/watch/" + kToken + "/");
+    CHECK(route.kind == RouteKind::kWatchFile);
+    CHECK(route.token == kToken);
+    CHECK(route.file.empty());
+  }
+  SECTION("its files") {
+    const auto bundle = route_request("GET", "/admin/watch/" + kToken + "/app.bundle.js");
+    CHECK(bundle.kind == RouteKind::kWatchFile);
+    CHECK(bundle.token == kToken);
+    CHECK(bundle.file == "app.bundle.js");
+    CHECK(route_request("GET", "/admin/watch/" + kToken + "/novnc/core/rfb.js").file == "novnc/core/rfb.js");
+  }
+  SECTION("status") {
+    const auto route = route_request("GET", "/admin/watch/" + kToken + "/status");
+    CHECK(route.kind == RouteKind::kWatchStatus);
+    CHECK(route.token == kToken);
+  }
+  SECTION("the WebSocket, with its query kept raw") {
+    const auto route = route_request("GET", "/admin/watch/" + kToken + "/ws?x=1");
+    CHECK(route.kind == RouteKind::kWatchSocket);
+    CHECK(route.token == kToken);
+    CHECK(route.query == "x=1");
+  }
+  SECTION("ws and status only as the whole rest") {
+    CHECK(kind("GET", "/admin/watch/" + kToken + "/ws/") == RouteKind::kWatchFile);
+    CHECK(kind("GET", "/admin/watch/" + kToken + "/status.json") == RouteKind::kWatchFile);
+  }
+  SECTION("HEAD as GET; other methods are refused") {
+    CHECK(kind("HEAD", "/admin/watch/" + kToken + "/") == RouteKind::kWatchFile);
+    const auto post = route_request("POST", "/admin/watch/" + kToken + "/ws");
+    CHECK(post.kind == RouteKind::kBadMethod);
+    CHECK(std::string(post.allowed) == "GET, HEAD");
+  }
+}
+
+TEST_CASE("watch paths without a valid token are not found, and never the admin page") {
+  CHECK(kind("GET", "/admin/watch/" + kToken) == RouteKind::kNotFound);  // no trailing slash
+  CHECK(kind("GET", "/admin/watch/") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/admin/watch//ws") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/admin/watch/" + kToken.substr(1) + "/") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/admin/watch/0123456789ABCDEF0123456789abcdef/ws") == RouteKind::kNotFound);
+  CHECK(kind("GET", "/admin/watch/../s/" + kToken + "/ws") == RouteKind::kNotFound);
+  // Only /admin/watch/ itself leads there: the admin page's own files and the participant's paths stay apart.
+  CHECK(kind("GET", "/admin/watch") == RouteKind::kAdminPage);
+  CHECK(kind("GET", "/admin/watching/" + kToken + "/") == RouteKind::kAdminPage);
+  CHECK(kind("GET", "/s/" + kToken + "/admin/watch/" + kToken + "/ws") == RouteKind::kSessionFile);
+}

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Sessions as browsers and the admin API see them.
+#include "session_views.hpp"
+
+#include <cstdio>
+
+#include "session_index.hpp"
+#include "web_policy.hpp"
+
+namespace rfbsim::manager {
+
+CloseNotice close_notice(SessionState state) {
+  // 1000 normal closure, 1001 going away (the page shows these as an ending), 1011 an error on our side.
+  switch (state) {
+    case SessionState::kFinished: return {1000, "session finished"};
+    case SessionState::kExpired: return {1001, "session expired"};
+    case SessionState::kIdle: return {1001, "session ended after being idle"};
+    case SessionState::kEnded: return {1001, "session ended by the researcher"};
+    case SessionState::kShutdown: return {1001, "server shutting down"};
+    case SessionState::kFailed: return {1011, "the simulator could not start"};
+    default: return {1011, "the simulator stopped unexpectedly"};
+  }
+}
+
+std::string status_json(const Session& session, WallTime now) {
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%.3f", std::chrono::duration<double>(now - session.created).count());
+  return std::string("{\"state\":\"") + state_name(session.state) + "\",\"ends_as\":\"" +
+         state_name(coming_state(session)) + "\",\"elapsed_s\":" + seconds + "}";
+}
+
+std::string session_json(const Session& s, bool include_token) {
+  const auto time = [](const std::optional<WallTime>& t) { return t ? "\"" + iso_utc(*t) + "\"" : std::string("null"); };
+  std::string json = "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"scenario\":\"" +
+                     json_escape(s.scenario) + "\",\"seed\":\"" + std::to_string(s.seed) + "\",\"state\":\"" +
+                     state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"exit_status\":\"" +
+                     json_escape(s.exit_status) + "\",\"created_at\":\"" + iso_utc(s.created) +
+                     "\",\"ready_at\":" + time(s.ready_at) + ",\"ended_at\":" + time(s.ended_at) +
+                     ",\"data_path\":\"" + json_escape(s.data_path) + "\",\"params\":" +
+                     (s.params_json.empty() ? "{}" : s.params_json);
+  if (include_token) json += ",\"token\":\"" + s.token + "\"";
+  return json + "}";
+}
+
+}  // namespace rfbsim::manager

@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// How sessions are shown: close notices per state, the page's status poll and the admin API's JSON.
+#include <catch2/catch.hpp>
+
+#include "session_index.hpp"
+#include "session_views.hpp"
+
+using rfbsim::manager::close_notice;
+using rfbsim::manager::coming_state;
+using rfbsim::manager::Session;
+using rfbsim::manager::SessionState;
+
+namespace {
+
+Session sample() {
+  Session s;
+  s.id = 7;
+  s.uid = "p-01";
+  s.token = "0123456789abcdef0123456789abcdef";
+  s.scenario = "lab";
+  s.params_json = R"({"uid":"p-01","scenario":"lab","seed":"42"})";
+  s.seed = 42;
+  s.state = SessionState::kRunning;
+  s.data_path = "/data/sessions/7-p-01";
+  s.created = *rfbsim::manager::parse_iso_utc("2026-11-24T10:00:00.000Z");
+  s.ready_at = rfbsim::manager::parse_iso_utc("2026-11-24T10:00:00.250Z");
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("each ending tells the browser its own close code and reason") {
+  CHECK(close_notice(SessionState::kFinished).code == 1000);
+  CHECK(close_notice(SessionState::kFinished).reason == "session finished");
+  CHECK(close_notice(SessionState::kExpired).code == 1001);
+  CHECK(close_notice(SessionState::kExpired).reason == "session expired");
+  CHECK(close_notice(SessionState::kIdle).reason == "session ended after being idle");
+  CHECK(close_notice(SessionState::kEnded).reason == "session ended by the researcher");
+  CHECK(close_notice(SessionState::kShutdown).code == 1001);
+  CHECK(close_notice(SessionState::kShutdown).reason == "server shutting down");
+  CHECK(close_notice(SessionState::kFailed).code == 1011);
+  CHECK(close_notice(SessionState::kFailed).reason == "the simulator could not start");
+  CHECK(close_notice(SessionState::kCrashed).code == 1011);
+  CHECK(close_notice(SessionState::kCrashed).reason == "the simulator stopped unexpectedly");
+}
+
+TEST_CASE("an ending session is shown as the state it is ending into") {
+  Session s = sample();
+  CHECK(coming_state(s) == SessionState::kRunning);
+  REQUIRE(rfbsim::manager::begin_ending(s, SessionState::kExpired, "time"));
+  CHECK(s.state == SessionState::kEnding);
+  CHECK(coming_state(s) == SessionState::kExpired);
+}
+
+TEST_CASE("the status poll gives the state, what it ends as, and the seconds since the link") {
+  Session s = sample();
+  const auto now = s.created + std::chrono::milliseconds(1500);
+  CHECK(rfbsim::manager::status_json(s, now) == R"({"state":"running","ends_as":"running","elapsed_s":1.500})");
+  REQUIRE(rfbsim::manager::begin_ending(s, SessionState::kEnded, "admin"));
+  CHECK(rfbsim::manager::status_json(s, now) == R"({"state":"ending","ends_as":"ended","elapsed_s":1.500})");
+}
+
+TEST_CASE("the admin API's session JSON names every field, and the token only when asked") {
+  Session s = sample();
+  s.detail = "said \"hi\"";
+  const std::string expected =
+      R"({"id":7,"uid":"p-01","scenario":"lab","seed":"42","state":"running","detail":"said \"hi\"",)"
+      R"("exit_status":"","created_at":"2026-11-24T10:00:00.000Z","ready_at":"2026-11-24T10:00:00.250Z",)"
+      R"("ended_at":null,"data_path":"/data/sessions/7-p-01","params":{"uid":"p-01","scenario":"lab","seed":"42"})";
+  CHECK(rfbsim::manager::session_json(s, false) == expected + "}");
+  CHECK(rfbsim::manager::session_json(s, true) == expected + R"(,"token":"0123456789abcdef0123456789abcdef"})");
+}
