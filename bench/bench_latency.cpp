@@ -13,9 +13,6 @@
 //   5. release the key and go back to 1.
 // libvncserver without ContinuousUpdates sends at most one update per request; libvncclient requests the
 // next one as soon as it has handled an update, so an update is at most one round trip behind a frame.
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <csignal>
 #include <cstdio>
 #include <exception>
@@ -101,40 +98,6 @@ Options parse_options(int argc, char** argv) {
   return o;
 }
 
-// Points this process's stderr at a log file while it lives, so that a child started meanwhile writes
-// its chatter there instead of between the table's lines.
-class StderrToFile {
- public:
-  explicit StderrToFile(const std::string& path) : saved_(::dup(STDERR_FILENO)) {
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
-    if (fd < 0) throw std::runtime_error("cannot open the sim log " + path);
-    ::dup2(fd, STDERR_FILENO);
-    ::close(fd);
-  }
-  ~StderrToFile() {
-    ::dup2(saved_, STDERR_FILENO);
-    ::close(saved_);
-  }
-  StderrToFile(const StderrToFile&) = delete;
-  StderrToFile& operator=(const StderrToFile&) = delete;
-
- private:
-  int saved_;
-};
-
-// The renderer sim_rfb announced last in its log ("[sim_rfb] rendering with ...").
-std::string sim_renderer(const std::string& log_path) {
-  std::ifstream log(log_path);
-  const std::string marker = "rendering with ";
-  std::string line;
-  std::string found = "unknown";
-  while (std::getline(log, line)) {
-    const std::size_t at = line.find(marker);
-    if (at != std::string::npos) found = line.substr(at + marker.size());
-  }
-  return found;
-}
-
 // Pumps until no update has arrived for `quiet`. Throws if that never happens or the connection drops.
 void settle(rfbsim::test::RfbTestClient& client, milliseconds quiet) {
   const auto deadline = Clock::now() + kSettleLimit;
@@ -157,7 +120,7 @@ struct ConfigResult {
 ConfigResult run_config(const Options& options, const bench::Size& size, int fps, std::mt19937& rng) {
   std::unique_ptr<rfbsim::test::SimProcess> sim;
   {
-    const StderrToFile redirect(options.sim_log);
+    const bench::StderrToFile redirect(options.sim_log);
     sim = std::make_unique<rfbsim::test::SimProcess>(
         options.sim, std::vector<std::string>{"--port", "0", "--width", std::to_string(size.width), "--height",
                                               std::to_string(size.height), "--fps", std::to_string(fps)});
@@ -231,7 +194,7 @@ int run(const Options& options) {
   }
 
   std::printf("bench_latency: sim_rfb rendering with %s; CPU %s; load average %s at start\n",
-              sim_renderer(options.sim_log).c_str(), bench::cpu_description().c_str(), load_at_start.c_str());
+              bench::renderer_in_log(options.sim_log).c_str(), bench::cpu_description().c_str(), load_at_start.c_str());
   std::printf("key '%c' down -> first update with mean abs difference > %.1f from the settled picture; ms over "
               "loopback, libvncclient, JPEG q80 4:2:0, sim ticks at 60 Hz\n\n",
               static_cast<char>(options.key), options.threshold);

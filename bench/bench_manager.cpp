@@ -176,18 +176,6 @@ IndexRow wait_for_row(const ManagerUnderTest& manager, const std::string& token,
                            (last ? last->state : "absent") + ")");
 }
 
-// The renderer a session announced in its log ("[sim_rfb] rendering with ...").
-std::string session_renderer(const IndexRow& row) {
-  std::ifstream log(std::filesystem::path(row.data_path) / "session.log");
-  const std::string marker = "rendering with ";
-  std::string line;
-  while (std::getline(log, line)) {
-    const std::size_t at = line.find(marker);
-    if (at != std::string::npos) return line.substr(at + marker.size());
-  }
-  return "unknown";
-}
-
 // ----------------------------------------------------------------------------------------------------------
 // 1. Link to first frame
 // ----------------------------------------------------------------------------------------------------------
@@ -231,7 +219,7 @@ FirstFrameResult run_first_frame(const Options& options, const ManagerUnderTest&
 
     const IndexRow row = wait_for_row(manager, token, [](const IndexRow& x) { return !x.ready_at.empty(); },
                                               kFirstUpdateTimeout, "became ready");
-    if (i == 0) r.renderer = session_renderer(row);
+    if (i == 0) r.renderer = bench::renderer_in_log((std::filesystem::path(row.data_path) / "session.log").string());
     const double ready = iso_ms(row.ready_at) - t0_wall;
     r.redirect_ms.push_back(bench::ms_between(t0, redirected));
     r.ready_ms.push_back(ready);

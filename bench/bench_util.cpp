@@ -168,4 +168,16 @@ StderrToFile::~StderrToFile() {
   ::close(saved_);
 }
 
+std::string renderer_in_log(const std::string& log_path) {
+  std::ifstream log(log_path);
+  const std::string marker = "rendering with ";
+  std::string line;
+  std::string found = "unknown";
+  while (std::getline(log, line)) {
+    const std::size_t at = line.find(marker);
+    if (at != std::string::npos) found = line.substr(at + marker.size());
+  }
+  return found;
+}
+
 }  // namespace rfbsim::bench

@@ -85,4 +85,7 @@ class StderrToFile {
   int saved_;  ///< a duplicate of the original stderr, put back on destruction
 };
 
+/// The renderer sim_rfb announced last in a log file ("[sim_rfb] rendering with ..."); "unknown" if none.
+std::string renderer_in_log(const std::string& log_path);
+
 }  // namespace rfbsim::bench

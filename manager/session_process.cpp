@@ -12,12 +12,14 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <charconv>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace rfbsim::manager {
 
@@ -182,43 +184,56 @@ bool signal_process_group(pid_t pgid, int signal) {
   return ::kill(-pgid, signal) == 0;
 }
 
+namespace {
+
+// The fields of a /proc/PID/stat file from field 3 (state) on; nothing if the process is gone. The command
+// name (field 2) is in parentheses and may hold spaces, so fields are counted after the last ')'.
+std::optional<std::vector<std::string>> stat_fields(const std::filesystem::path& stat_file) {
+  std::ifstream stat(stat_file);
+  std::string text;
+  if (!std::getline(stat, text)) return std::nullopt;
+  const std::size_t close = text.rfind(')');
+  if (close == std::string::npos || close + 2 > text.size()) return std::nullopt;
+  std::istringstream stream(text.substr(close + 2));
+  std::vector<std::string> fields;
+  for (std::string field; stream >> field;) fields.push_back(field);
+  return fields;
+}
+
+// Indexes into stat_fields(): field N of proc(5) is at N - 3.
+constexpr std::size_t kStateField = 0;        // field 3
+constexpr std::size_t kGroupField = 2;        // field 5, pgrp
+constexpr std::size_t kStartTimeField = 19;   // field 22, starttime in clock ticks
+
+}  // namespace
+
 bool process_group_alive(pid_t pgid) {
   if (pgid <= 1) return false;
   if (::kill(-pgid, 0) != 0 && errno != EPERM) return false;
   // The group exists, but zombies count too: a dead session whose new parent (init, after the manager
   // died) has not reaped it yet is gone for our purposes. Look for a member that still runs.
+  const std::string group = std::to_string(pgid);
   std::error_code ec;
   for (auto it = std::filesystem::directory_iterator("/proc", ec); !ec && it != std::filesystem::directory_iterator();
        it.increment(ec)) {
     const std::string name = it->path().filename().string();
     if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
-    std::ifstream stat(it->path() / "stat");
-    std::string text;
-    if (!std::getline(stat, text)) continue;
-    const std::size_t close = text.rfind(')');
-    if (close == std::string::npos) continue;
-    std::istringstream fields(text.substr(close + 2));
-    std::string state;
-    long parent = 0, group = 0;
-    if (fields >> state >> parent >> group && group == pgid && state != "Z" && state != "X") return true;
+    const auto fields = stat_fields(it->path() / "stat");
+    if (!fields || fields->size() <= kGroupField || (*fields)[kGroupField] != group) continue;
+    const std::string& state = (*fields)[kStateField];
+    if (state != "Z" && state != "X") return true;
   }
   return false;
 }
 
 std::optional<std::int64_t> process_start_ticks(pid_t pid) {
-  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-  std::string text;
-  if (!std::getline(stat, text)) return std::nullopt;
-  // The command name (field 2) is in parentheses and may hold spaces: count fields after the last ')'.
-  const std::size_t close = text.rfind(')');
-  if (close == std::string::npos) return std::nullopt;
-  std::istringstream fields(text.substr(close + 2));
-  std::string field;
-  for (int index = 3; index <= 22; ++index) {
-    if (!(fields >> field)) return std::nullopt;
-    if (index == 22) return std::stoll(field);
-  }
-  return std::nullopt;
+  const auto fields = stat_fields("/proc/" + std::to_string(pid) + "/stat");
+  if (!fields || fields->size() <= kStartTimeField) return std::nullopt;
+  std::int64_t ticks = 0;
+  const std::string& text = (*fields)[kStartTimeField];
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), ticks);
+  if (ec != std::errc() || ptr != text.data() + text.size()) return std::nullopt;
+  return ticks;
 }
 
 }  // namespace rfbsim::manager
