@@ -12,6 +12,16 @@ find_package(websocketpp CONFIG REQUIRED)            # websocketpp::websocketpp 
 find_package(Boost REQUIRED COMPONENTS system)       # websocketpp's asio transport
 find_package(OpenSSL 3 REQUIRED)                     # OpenSSL::SSL, OpenSSL::Crypto: TLS, signed links, tokens
 find_package(SQLite3 REQUIRED)                       # SQLite::SQLite3: sim_manager's session index
+find_package(nlohmann_json 3 REQUIRED CONFIG)        # nlohmann_json::nlohmann_json: session data (record/, tools/)
+find_package(Freetype REQUIRED)                      # Freetype::Freetype: the HUD's text (render/)
+# libavcodec/-format/-util and libswscale: sim_replay's H.264 video (FFmpeg has no CMake config)
+pkg_check_modules(LIBAV REQUIRED IMPORTED_TARGET libavcodec libavformat libavutil libswscale)
+# The HUD's font: DejaVu Sans from fonts-dejavu-core, looked up at run time in this folder first.
+find_file(RFBSIM_HUD_FONT DejaVuSans.ttf PATHS /usr/share/fonts/truetype/dejavu NO_DEFAULT_PATH
+          DOC "TrueType font for the HUD (fonts-dejavu-core)")
+if(NOT RFBSIM_HUD_FONT)
+  message(FATAL_ERROR "rfbsim: DejaVuSans.ttf not found (apt-get install fonts-dejavu-core, or set RFBSIM_HUD_FONT)")
+endif()
 if(RFBSIM_BUILD_TESTS)
   find_package(Catch2 2 REQUIRED)
   include(Catch)

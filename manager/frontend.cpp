@@ -47,6 +47,26 @@ void close_with(Connection& connection, SessionState state) {
   connection.close(static_cast<CloseCode>(notice.code), notice.reason, ec);
 }
 
+// The PROXY protocol line (version 1) that tells a session which browser a relayed connection is for.
+template <typename Connection>
+std::string proxy_line_for(Connection& con) {
+  boost::system::error_code ec;
+  auto& socket = con.get_raw_socket().lowest_layer();
+  const auto remote = socket.remote_endpoint(ec);
+  const auto local = ec ? decltype(remote)() : socket.local_endpoint(ec);
+  if (ec) return "PROXY UNKNOWN\r\n";
+  auto source = remote.address();
+  auto destination = local.address();
+  // A dual-stack listener sees IPv4 browsers as ::ffff:a.b.c.d; name them as the IPv4 they are.
+  if (source.is_v6() && source.to_v6().is_v4_mapped()) source = asio::ip::make_address_v4(asio::ip::v4_mapped, source.to_v6());
+  if (destination.is_v6() && destination.to_v6().is_v4_mapped()) {
+    destination = asio::ip::make_address_v4(asio::ip::v4_mapped, destination.to_v6());
+  }
+  if (source.is_v4() != destination.is_v4()) return "PROXY UNKNOWN\r\n";
+  return std::string("PROXY ") + (source.is_v4() ? "TCP4 " : "TCP6 ") + source.to_string() + " " +
+         destination.to_string() + " " + std::to_string(remote.port()) + " " + std::to_string(local.port()) + "\r\n";
+}
+
 std::string read_file(const std::filesystem::path& path, bool& ok) {
   std::ifstream in(path, std::ios::binary);
   ok = static_cast<bool>(in) && std::filesystem::is_regular_file(path);
@@ -185,7 +205,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
       case RouteKind::kHome: respond_page(con, 200, home_page()); return;
       case RouteKind::kStart: handle_start(con, route); return;
       case RouteKind::kSessionFile: handle_session_file(con, route, page_headers(config_.frame_origins)); return;
-      case RouteKind::kSessionStatus: handle_session_status(con, route); return;
+      case RouteKind::kSessionStatus: handle_session_status(con, route, config_.frame_origins); return;
       case RouteKind::kSessionSocket:
         refuse(con, 400, Rejection::kBadRequest, "WebSocket only", "This address takes WebSocket connections only.");
         return;
@@ -195,7 +215,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
         if (admin_allowed(con)) handle_session_file(con, route, page_headers({}));
         return;
       case RouteKind::kWatchStatus:
-        if (admin_allowed(con)) handle_session_status(con, route);
+        if (admin_allowed(con)) handle_session_status(con, route, {});
         return;
       case RouteKind::kWatchSocket:
         if (admin_allowed(con)) {
@@ -290,14 +310,15 @@ class FrontendImpl final : public Frontend, public SessionListener {
     respond(con, 200, body, std::string(detail::mime_type_for(*path)), headers);
   }
 
-  void handle_session_status(const ConnectionPtr& con, const Route& route) {
+  void handle_session_status(const ConnectionPtr& con, const Route& route,
+                             const std::vector<std::string>& survey_origins) {
     const auto session = supervisor_.find(route.token);
     if (!session) {
       metrics_.count_rejection(Rejection::kUnknownSession);
       respond_json(con, 404, "{\"error\":\"unknown session\"}");
       return;
     }
-    respond_json(con, 200, status_json(*session, std::chrono::system_clock::now()));
+    respond_json(con, 200, status_json(*session, std::chrono::system_clock::now(), survey_origins));
   }
 
   bool admin_allowed(const ConnectionPtr& con) {
@@ -447,6 +468,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
     metrics_.count_relay_open(kind);
     // Only the participant counts as connected: a researcher watching must not keep an idle session alive.
     if (kind == RelayKind::kParticipant) supervisor_.client_connected(session->id);
+    // sim_rfb takes the browser's address from a PROXY line; a legacy program would take it for RFB bytes.
+    if (config_.session_kind == SessionKind::kSimRfb) relay->set_proxy_line(proxy_line_for(*con));
     if (session->state == SessionState::kRunning) relay->connect(session->port);
   }
 

@@ -38,6 +38,8 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
                                                                       {"{scenario}", scenario},
                                                                       {"{seed}", std::to_string(context.seed)},
                                                                       {"{uid}", request.uid},
+                                                                      {"{t1}", request.code_success},
+                                                                      {"{t2}", request.code_timeout},
                                                                       {"{data_dir}", context.data_dir}};
     std::vector<std::string> args;
     for (const std::string& arg : config.session_args) args.push_back(expand(arg, values));
@@ -55,6 +57,11 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
     args.emplace_back(param->flag);
     args.push_back(value);
   }
+  // Session data goes to the session's folder; the codes are shown in the picture when the task ends. The
+  // relay names each browser's address in a PROXY line, which sim_rfb records hashed.
+  args.insert(args.end(), {"--proxy-protocol", "--data-dir", context.data_dir, "--uid", request.uid});
+  if (!request.code_success.empty()) args.insert(args.end(), {"--code-success", request.code_success});
+  if (!request.code_timeout.empty()) args.insert(args.end(), {"--code-timeout", request.code_timeout});
   args.insert(args.end(), config.session_args.begin(), config.session_args.end());
   return args;
 }
@@ -65,6 +72,8 @@ std::string parameters_json(const StartRequest& request, std::uint64_t seed) {
   for (const auto& [name, value] : request.overrides) {
     json += ",\"" + json_escape(name) + "\":\"" + json_escape(value) + "\"";
   }
+  if (!request.code_success.empty()) json += ",\"t1\":\"" + json_escape(request.code_success) + "\"";
+  if (!request.code_timeout.empty()) json += ",\"t2\":\"" + json_escape(request.code_timeout) + "\"";
   return json + "}";
 }
 

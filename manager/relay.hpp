@@ -59,10 +59,18 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   [[nodiscard]] RelayKind kind() const { return kind_; }
   [[nodiscard]] bool connecting_or_connected() const { return connect_started_; }
 
+  /// A PROXY protocol line naming the browser's address, sent to the session before any browser byte
+  /// (sim_rfb records the participant's address, hashed, rather than ours). Call before connect().
+  void set_proxy_line(std::string line) { proxy_line_ = std::move(line); }
+
   /// Connects to the session's port and starts relaying (browser bytes received so far go first).
   void connect(int port) {
     if (connect_started_ || closed_) return;
     connect_started_ = true;
+    if (!proxy_line_.empty()) {
+      pending_bytes_ += proxy_line_.size();
+      pending_.push_front(proxy_line_);
+    }
     const boost::asio::ip::tcp::endpoint endpoint(boost::asio::ip::address_v4::loopback(),
                                                   static_cast<unsigned short>(port));
     upstream_.async_connect(endpoint, [self = this->shared_from_this()](const boost::system::error_code& ec) {
@@ -195,6 +203,7 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   boost::asio::steady_timer drain_timer_;
   std::array<char, 64 * 1024> buffer_{};
   std::deque<std::string> pending_;
+  std::string proxy_line_;
   std::size_t pending_bytes_ = 0;
   bool connect_started_ = false;
   bool connected_ = false;

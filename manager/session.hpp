@@ -69,6 +69,9 @@ struct Session {
   std::int64_t process_start = 0;  ///< the process's start time in clock ticks (/proc), to recognise it later
   int port = 0;                 ///< loopback port the session serves RFB on, once known
   std::string data_path;        ///< the session's folder
+  std::string code_success;     ///< the link's t1 (shown and sent to the survey on success); may be empty
+  std::string code_timeout;     ///< the link's t2 (on timeout); may be empty
+  std::string outcome;          ///< the task's outcome as the simulator reported it: "", completed, timeout
   WallTime created{};           ///< /start accepted
   std::optional<WallTime> ready_at;  ///< the program reported ready
   std::optional<WallTime> ended_at;  ///< the process was gone

@@ -25,7 +25,9 @@ CREATE TABLE IF NOT EXISTS sessions (
                                         -- crashed failed interrupted
   detail        TEXT NOT NULL DEFAULT '',
   exit_status   TEXT NOT NULL DEFAULT '',  -- "exit N" or "signal N" once the process is gone
-  outcome       TEXT,                   -- the study task's outcome, written by the simulator's tooling
+  outcome       TEXT,                   -- the task's outcome as sim_rfb reported it: completed, timeout
+  code_success  TEXT NOT NULL DEFAULT '',  -- the link's completion codes (t1, t2)
+  code_timeout  TEXT NOT NULL DEFAULT '',
   pid           INTEGER,                -- also the process group id
   process_start INTEGER,                -- /proc start time in clock ticks: recognises the process later
   port          INTEGER,
@@ -40,7 +42,7 @@ CREATE INDEX IF NOT EXISTS sessions_by_state ON sessions (state);
 
 constexpr const char* kColumns =
     "id, uid, token, scenario, params, seed, host_id, state, detail, exit_status, pid, process_start, port, "
-    "data_path, created_at, ready_at, ended_at";
+    "data_path, created_at, ready_at, ended_at, outcome, code_success, code_timeout";
 
 // One prepared statement, finalized on scope exit.
 class Statement {
@@ -58,6 +60,7 @@ class Statement {
     sqlite3_bind_text(stmt_, index, text.c_str(), static_cast<int>(text.size()), SQLITE_TRANSIENT);
   }
   void bind(int index, std::int64_t value) { sqlite3_bind_int64(stmt_, index, value); }
+  void bind_null(int index) { sqlite3_bind_null(stmt_, index); }
   void bind(int index, const std::optional<WallTime>& time) {
     if (time) {
       bind(index, iso_utc(*time));
@@ -103,6 +106,9 @@ Session read_row(Statement& row) {
   s.created = parse_iso_utc(row.text(14)).value_or(WallTime{});
   if (!row.is_null(15)) s.ready_at = parse_iso_utc(row.text(15));
   if (!row.is_null(16)) s.ended_at = parse_iso_utc(row.text(16));
+  s.outcome = row.text(17);
+  s.code_success = row.text(18);
+  s.code_timeout = row.text(19);
   return s;
 }
 
@@ -154,6 +160,7 @@ SessionIndex::SessionIndex(const std::string& path) : path_(path) {
     exec("PRAGMA journal_mode = WAL");
     exec("PRAGMA synchronous = FULL");
     exec(kSchema);
+    add_missing_columns();
   } catch (const std::exception& error) {
     sqlite3_close(db_);
     db_ = nullptr;
@@ -162,6 +169,17 @@ SessionIndex::SessionIndex(const std::string& path) : path_(path) {
 }
 
 SessionIndex::~SessionIndex() { sqlite3_close(db_); }
+
+void SessionIndex::add_missing_columns() {
+  // An index made by an earlier version lacks the completion codes: add them, so that a study can keep
+  // its index across an upgrade.
+  bool has_codes = false;
+  Statement columns(db_, "PRAGMA table_info(sessions)");
+  while (columns.step()) has_codes = has_codes || columns.text(1) == "code_success";
+  if (has_codes) return;
+  exec("ALTER TABLE sessions ADD COLUMN code_success TEXT NOT NULL DEFAULT ''");
+  exec("ALTER TABLE sessions ADD COLUMN code_timeout TEXT NOT NULL DEFAULT ''");
+}
 
 void SessionIndex::exec(const char* sql) {
   char* message = nullptr;
@@ -175,7 +193,8 @@ void SessionIndex::exec(const char* sql) {
 std::int64_t SessionIndex::insert(const Session& s) {
   Statement insert(db_,
                    "INSERT INTO sessions (uid, token, scenario, params, seed, host_id, state, detail, pid, "
-                   "process_start, port, data_path, created_at) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?)");
+                   "process_start, port, data_path, created_at, code_success, code_timeout) "
+                   "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
   insert.bind(1, s.uid);
   insert.bind(2, s.token);
   insert.bind(3, s.scenario);
@@ -189,6 +208,8 @@ std::int64_t SessionIndex::insert(const Session& s) {
   insert.bind(11, static_cast<std::int64_t>(s.port));
   insert.bind(12, s.data_path);
   insert.bind(13, iso_utc(s.created));
+  insert.bind(14, s.code_success);
+  insert.bind(15, s.code_timeout);
   insert.step();
   return sqlite3_last_insert_rowid(db_);
 }
@@ -196,7 +217,7 @@ std::int64_t SessionIndex::insert(const Session& s) {
 void SessionIndex::update(const Session& s) {
   Statement update(db_,
                    "UPDATE sessions SET state = ?, detail = ?, exit_status = ?, pid = ?, process_start = ?, "
-                   "port = ?, data_path = ?, ready_at = ?, ended_at = ? WHERE id = ?");
+                   "port = ?, data_path = ?, ready_at = ?, ended_at = ?, outcome = ? WHERE id = ?");
   update.bind(1, std::string(state_name(s.state)));
   update.bind(2, s.detail);
   update.bind(3, s.exit_status);
@@ -206,7 +227,12 @@ void SessionIndex::update(const Session& s) {
   update.bind(7, s.data_path);
   update.bind(8, s.ready_at);
   update.bind(9, s.ended_at);
-  update.bind(10, s.id);
+  if (s.outcome.empty()) {
+    update.bind_null(10);
+  } else {
+    update.bind(10, s.outcome);
+  }
+  update.bind(11, s.id);
   update.step();
   if (sqlite3_changes(db_) != 1) {
     throw std::runtime_error("session index: no session " + std::to_string(s.id) + " to update");

@@ -46,6 +46,7 @@ class SessionIndex {
  private:
   std::vector<Session> query(const std::string& where, const std::vector<std::string>& binds);
   void exec(const char* sql);
+  void add_missing_columns();
   sqlite3* db_ = nullptr;
   std::string path_;
 };

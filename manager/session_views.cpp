@@ -22,11 +22,19 @@ CloseNotice close_notice(SessionState state) {
   }
 }
 
-std::string status_json(const Session& session, WallTime now) {
+std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins) {
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.3f", std::chrono::duration<double>(now - session.created).count());
+  const auto quoted = [](const std::string& text) { return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\""; };
+  const std::string& code = session.outcome == "completed" ? session.code_success
+                            : session.outcome == "timeout" ? session.code_timeout
+                                                           : session.outcome;  // empty without an outcome
+  std::string origins;
+  for (const std::string& origin : survey_origins) origins += (origins.empty() ? "\"" : ",\"") + json_escape(origin) + "\"";
   return std::string("{\"state\":\"") + state_name(session.state) + "\",\"ends_as\":\"" +
-         state_name(coming_state(session)) + "\",\"elapsed_s\":" + seconds + "}";
+         state_name(coming_state(session)) + "\",\"elapsed_s\":" + seconds + ",\"uid\":\"" + json_escape(session.uid) +
+         "\",\"outcome\":" + quoted(session.outcome) + ",\"code\":" + quoted(code) + ",\"survey_origins\":[" +
+         origins + "]}";
 }
 
 std::string session_json(const Session& s, bool include_token) {
@@ -36,7 +44,8 @@ std::string session_json(const Session& s, bool include_token) {
                      state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"exit_status\":\"" +
                      json_escape(s.exit_status) + "\",\"created_at\":\"" + iso_utc(s.created) +
                      "\",\"ready_at\":" + time(s.ready_at) + ",\"ended_at\":" + time(s.ended_at) +
-                     ",\"data_path\":\"" + json_escape(s.data_path) + "\",\"params\":" +
+                     ",\"data_path\":\"" + json_escape(s.data_path) + "\",\"outcome\":" +
+                     (s.outcome.empty() ? std::string("null") : "\"" + json_escape(s.outcome) + "\"") + ",\"params\":" +
                      (s.params_json.empty() ? "{}" : s.params_json);
   if (include_token) json += ",\"token\":\"" + s.token + "\"";
   return json + "}";

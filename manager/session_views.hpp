@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "session.hpp"
 
@@ -18,9 +19,11 @@ struct CloseNotice {
 /// What a browser is told when its session closes, by the state the session has or is ending into.
 CloseNotice close_notice(SessionState state);
 
-/// The page's start-up poll (/s/<token>/status): {"state":..., "ends_as":..., "elapsed_s": seconds since
-/// /start, 3 decimals}.
-std::string status_json(const Session& session, WallTime now);
+/// The page's poll (/s/<token>/status): {"state":..., "ends_as":..., "elapsed_s": seconds since /start,
+/// 3 decimals, "uid":..., "outcome": "completed" | "timeout" | null, "code": the outcome's completion code
+/// or null, "survey_origins": [...]}. The page posts the outcome to its parent window, and only to
+/// `survey_origins` (a watching researcher's page gets none).
+std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins);
 
 /// One session for the admin API: id, uid, scenario, seed, state, detail, exit status, times, data path and
 /// the link's parameters; the token only when `include_token` (live sessions, which a researcher may watch).

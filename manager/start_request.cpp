@@ -124,6 +124,12 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
       }
       request.scenario = value;
       have_scenario = true;
+    } else if (name == "t1" || name == "t2") {
+      if (!is_identifier(value)) {
+        out.error = name + " '" + shown(value) + "' is not valid: use 1 to 64 letters, digits, '-' or '_'";
+        return out;
+      }
+      (name == "t1" ? request.code_success : request.code_timeout) = value;
     } else if (name == "seed") {
       request.seed = strict_seed(value);
       if (!request.seed) {

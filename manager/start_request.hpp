@@ -22,6 +22,10 @@ struct StartRequest {
   /// Scenario overrides as (link parameter, value), in the order of kOverrideParams; e.g.
   /// ("avatar_start", "1.5,-2,0.25") or ("crowd", "10").
   std::vector<std::pair<std::string, std::string>> overrides;
+  /// Completion codes (SEAN-EP's t1 and t2): shown to the participant and sent to the survey on success and
+  /// on timeout; identifiers, empty when the link has none.
+  std::string code_success;
+  std::string code_timeout;
 };
 
 /// The link parameters that override the scenario, with the sim_rfb flag each becomes.

@@ -180,6 +180,8 @@ StartOutcome Supervisor::start(const StartRequest& request) {
   session.scenario = request.scenario;
   session.seed = request.seed.value_or(new_seed());
   session.params_json = parameters_json(request, session.seed);
+  session.code_success = request.code_success;
+  session.code_timeout = request.code_timeout;
   session.host_id = config_.host_id;
   session.created = std::chrono::system_clock::now();
   const auto started = SteadyClock::now();
@@ -268,28 +270,45 @@ void Supervisor::watch_ready_pipe(Session& session) {
   rt.ready_pipe.async_read_some(asio::buffer(rt.buffer), [this, id](const boost::system::error_code& ec,
                                                                     std::size_t bytes) {
     Session* s = table_.by_id(id);
-    if (s == nullptr || s->state != SessionState::kStarting) return;
+    if (s == nullptr || ec) return;  // closed: the exit (or the start timeout) tells the rest
     Runtime& r = runtime(id);
-    if (ec) return;  // closed without a line: the exit (or the start timeout) tells the rest
     r.ready_text.append(r.buffer.data(), bytes);
-    const std::size_t newline = r.ready_text.find('\n');
-    if (newline == std::string::npos) {
-      if (r.ready_text.size() > 32) {
-        begin_end(*s, SessionState::kFailed, "the program's ready line is not 'ready PORT'");
-      } else {
-        watch_ready_pipe(*s);
-      }
-      return;
+    // Whole lines: the first says ready, later ones report the task's outcome.
+    for (std::size_t newline = r.ready_text.find('\n'); newline != std::string::npos;
+         newline = r.ready_text.find('\n')) {
+      const std::string line = r.ready_text.substr(0, newline);
+      r.ready_text.erase(0, newline + 1);
+      if (!take_pipe_line(*s, line)) return;
     }
+    if (r.ready_text.size() > 64) {
+      if (s->state == SessionState::kStarting) {
+        begin_end(*s, SessionState::kFailed, "the program's ready line is not 'ready PORT'");
+      }
+      return;  // a running program that writes nonsense is not listened to any more
+    }
+    watch_ready_pipe(*s);
+  });
+}
+
+bool Supervisor::take_pipe_line(Session& session, const std::string& line) {
+  if (session.state == SessionState::kStarting) {
     int port = 0;
     char rest = 0;
-    if (std::sscanf(r.ready_text.substr(0, newline).c_str(), "ready %d%c", &port, &rest) != 1 || port < 1 ||
-        port > 65535) {
-      begin_end(*s, SessionState::kFailed, "the program's ready line is not 'ready PORT'");
-      return;
+    if (std::sscanf(line.c_str(), "ready %d%c", &port, &rest) != 1 || port < 1 || port > 65535) {
+      begin_end(session, SessionState::kFailed, "the program's ready line is not 'ready PORT'");
+      return false;
     }
-    mark_ready(*s, port);
-  });
+    mark_ready(session, port);
+    return true;
+  }
+  if ((line == "outcome completed" || line == "outcome timeout") && session.outcome.empty()) {
+    session.outcome = line.substr(8);
+    save(session);
+    log_session(session, "task outcome: " + session.outcome);
+    return true;
+  }
+  log_session(session, "ignored a line from the program: '" + line.substr(0, 64) + "'");
+  return true;
 }
 
 void Supervisor::poll_rfb_port(std::int64_t id) {

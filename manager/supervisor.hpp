@@ -81,6 +81,9 @@ class Supervisor {
 
   void begin_end(Session& session, SessionState end_as, const std::string& detail);
   void watch_ready_pipe(Session& session);
+  // One line from the program's pipe: "ready PORT" while starting, then "outcome completed|timeout".
+  // False when the session was failed for it.
+  bool take_pipe_line(Session& session, const std::string& line);
   void poll_rfb_port(std::int64_t id);
   void mark_ready(Session& session, int port);
   void reap_children();

@@ -2,6 +2,7 @@
 // rfbsim participant page logic: connects noVNC to this session's simulator and keeps hints and messages in step.
 
 import RFB from './novnc/core/rfb.js';
+import { SurveyReporter } from './survey.js';
 
 // ---------------------------------------------------------------------------------------------------------------
 // Page elements (all exist in index.html).
@@ -69,6 +70,12 @@ state.options = options;
 const watching = window.location.pathname.startsWith('/admin/watch/');
 state.watching = watching;
 
+// The survey around this page (if any) hears how the session goes; a researcher's watching page tells no one.
+const survey = new SurveyReporter(watching ? null : window.parent, window);
+state.outcome = null;          // 'completed' | 'timeout' once the task has an outcome (from sim_manager)
+state.completionCode = null;   // the code the link carried for that outcome
+state.surveyEvents = survey.sent;  // the events posted to the survey so far (a Set, for tests)
+
 // ---------------------------------------------------------------------------------------------------------------
 // Addresses, relative to this page so that they work both under sim_manager (/s/<token>/) and from sim_rfb
 // itself (/, where any WebSocket path is accepted and 'status' does not exist).
@@ -92,6 +99,7 @@ statusUrl.hash = '';
 // "ends_as": <the state it ends in>, "elapsed_s": seconds since the link was opened}.
 // ---------------------------------------------------------------------------------------------------------------
 const STATUS_POLL_MS = 250;       // while no picture shows, the status is asked for this often
+const OUTCOME_POLL_MS = 1000;     // in a survey, while the session runs: how soon the survey hears the outcome
 const STATUS_TIMEOUT_MS = 2000;   // one status request may take this long
 const LIVE_STATES = new Set(['starting', 'running']);
 
@@ -149,6 +157,12 @@ async function fetchSessionStatus() {
     elapsedS: Number.isFinite(body.elapsed_s) ? body.elapsed_s : null,
   };
   state.sessionState = status.state;
+  if ((body.outcome === 'completed' || body.outcome === 'timeout') && state.outcome === null) {
+    state.outcome = body.outcome;
+    state.completionCode = typeof body.code === 'string' ? body.code : null;
+    updateFocus();
+  }
+  survey.update(body);
   startingSince = status.state === 'starting' && status.elapsedS !== null
     ? { elapsedS: status.elapsedS, at: performance.now() } : null;
   return status;
@@ -168,6 +182,11 @@ function startStatusPolling() {
       await new Promise((resolve) => setTimeout(resolve, STATUS_POLL_MS));
     }
     if (pictureShown) {
+      await fetchSessionStatus();
+    }
+    // Inside a survey, keep asking while the session runs, so that the survey hears the outcome within a second.
+    while (statusAvailable && survey.enabled && state.connected && state.outcome === null) {
+      await new Promise((resolve) => setTimeout(resolve, OUTCOME_POLL_MS));
       await fetchSessionStatus();
     }
     statusPolling = false;
@@ -210,7 +229,8 @@ function showProgress() {
 // itself not focused).
 function updateFocus() {
   state.focused = canvas !== null && document.hasFocus() && document.activeElement === canvas;
-  ui.hint.hidden = watching || !state.connected || state.focused;
+  // After the outcome the hint would cover the completion code drawn in the picture.
+  ui.hint.hidden = watching || !state.connected || state.focused || state.outcome !== null;
 }
 
 // The panel after a disconnect. `final`: the session is over for good, so there is nothing to reconnect to.
@@ -264,7 +284,9 @@ function firstPictureShown() {
   if (state.firstFrameAt === null) {
     state.firstFrameAt = performance.now();
   }
+  survey.started();
   showProgress();
+  startStatusPolling();
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -402,6 +424,10 @@ async function finishAttempt(info) {
     if (RESTARTABLE_STATES.has(session.endsAs)) {
       message += ' Opening your study link again starts a new session.';
     }
+    if (state.completionCode !== null) {
+      message += ` Your completion code: ${state.completionCode}`;
+    }
+    survey.ended();
     state.lastDisconnect = { ...info, kind: 'ended', final: true, sessionState: session.state, message };
     showDisconnected('Session ended', message, true);
     return;

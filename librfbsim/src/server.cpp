@@ -37,6 +37,7 @@
 #include "http_request.hpp"
 #include "http_service.hpp"
 #include "listener.hpp"
+#include "proxy_header.hpp"
 #include "rfbsim/tile_damage.hpp"
 
 namespace rfbsim {
@@ -142,6 +143,8 @@ struct ClientState {
 struct PendingConnection {
   int fd = -1;
   Clock::time_point accepted{};
+  bool proxied = false;   // its PROXY line was read (or none is expected)
+  std::string address;    // from the PROXY line; "" = the socket's peer
 };
 
 struct Server::Impl {
@@ -151,7 +154,10 @@ struct Server::Impl {
   void run();
   void accept_new();
   void classify_pending();
-  void adopt_rfb(int fd);
+  // Hands a connection to libvncserver; `address` (from a PROXY line) replaces the socket's peer if given.
+  void adopt_rfb(int fd, const std::string& address = "");
+  // Reads a pending connection's PROXY line once it is whole. False: close the connection (no valid line).
+  bool take_proxy_header(PendingConnection& connection, std::string_view bytes, Clock::time_point now);
   void apply_newest_frame();
   void serve_clients(const std::vector<pollfd>& polled);
   bool may_send_update(rfbClientPtr cl, Clock::time_point now);
@@ -183,6 +189,7 @@ struct Server::Impl {
   std::unique_ptr<detail::HttpService> http;
   detail::CallWatchdog watchdog;          // cuts off a client that blocks the network thread
   int adopting_guard_fd = -1;             // handed from adopt_rfb to on_new_client
+  std::string adopting_address;           // handed from adopt_rfb to on_new_client; "" = the socket's peer
   bool any_backed_up = false;             // some client's output is above kMaxUnsentBytes
   int next_client_id = 1;
 
@@ -385,11 +392,11 @@ void Server::Impl::accept_new() {
     if (fd < 0) return;  // EAGAIN: no more; other errors (EMFILE...) are retried on the next wake
     // Nothing HTTP to serve: whatever the peer speaks is libvncserver's to take (RFB, RFB over WebSocket)
     // or to refuse (a plain HTTP request, garbage), as if it owned the port.
-    if (!serves_http) {
+    if (!serves_http && !options.proxy_protocol) {
       adopt_rfb(fd);
       continue;
     }
-    pending.push_back({fd, Clock::now()});
+    pending.push_back({fd, Clock::now(), !options.proxy_protocol, ""});
   }
 }
 
@@ -404,6 +411,24 @@ void Server::Impl::classify_pending() {
       continue;
     }
     const std::string_view bytes(peeked, n > 0 ? static_cast<std::size_t>(n) : 0U);
+    if (!it->proxied) {
+      if (!take_proxy_header(*it, bytes, now)) {
+        ::close(it->fd);
+        it = pending.erase(it);
+        continue;
+      }
+      if (!it->proxied) {
+        ++it;  // the line is still coming
+        continue;
+      }
+      if (!serves_http) {
+        adopt_rfb(it->fd, it->address);
+        it = pending.erase(it);
+        continue;
+      }
+      ++it;  // sniff the client's own bytes at the next wake
+      continue;
+    }
     auto protocol = detail::sniff_protocol(bytes);
     if (protocol == detail::WireProtocol::Undecided && now - it->accepted >= kSniffTimeout) {
       // Silence means a raw RFB client waiting for our greeting; a half-sent HTTP head gets its error.
@@ -415,7 +440,7 @@ void Server::Impl::classify_pending() {
         continue;
       case detail::WireProtocol::Rfb:
       case detail::WireProtocol::WebSocket:
-        adopt_rfb(it->fd);
+        adopt_rfb(it->fd, it->address);
         break;
       case detail::WireProtocol::Http:
         http->serve(it->fd);
@@ -425,7 +450,30 @@ void Server::Impl::classify_pending() {
   }
 }
 
-void Server::Impl::adopt_rfb(int fd) {
+bool Server::Impl::take_proxy_header(PendingConnection& connection, std::string_view bytes, Clock::time_point now) {
+  const detail::ProxyHeader header = detail::parse_proxy_header(bytes);
+  switch (header.status) {
+    case detail::ProxyHeader::Status::Incomplete:
+      if (now - connection.accepted < options.read_timeout) return true;
+      std::fprintf(stderr, "[rfbsim.server] closing a connection: no PROXY line within %lld ms\n",
+                   static_cast<long long>(options.read_timeout.count()));
+      return false;
+    case detail::ProxyHeader::Status::Invalid:
+      std::fprintf(stderr, "[rfbsim.server] closing a connection: it did not begin with a PROXY line\n");
+      return false;
+    case detail::ProxyHeader::Status::Valid: break;
+  }
+  // Consume exactly the line: what follows is the client's own.
+  char line[detail::kMaxProxyHeaderBytes];
+  const auto n = ::recv(connection.fd, line, header.length, MSG_DONTWAIT);
+  if (n != static_cast<ssize_t>(header.length)) return false;
+  connection.proxied = true;
+  connection.address = header.source;
+  connection.accepted = now;  // the sniff's clock starts with the client's own bytes
+  return true;
+}
+
+void Server::Impl::adopt_rfb(int fd, const std::string& address) {
   const int one = 1;
   ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
   ::setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &kSendBufferBytes, sizeof kSendBufferBytes);
@@ -439,6 +487,7 @@ void Server::Impl::adopt_rfb(int fd) {
     return;
   }
   adopting_guard_fd = guard;
+  adopting_address = address;
   watchdog.arm(guard, Clock::now() + options.read_timeout);
   rfbNewClient(screen, fd);
   watchdog.disarm();
@@ -477,7 +526,7 @@ rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
   }
   auto* state = new ClientState;
   state->info.id = self.next_client_id++;
-  state->info.address = peer_address(cl->sock);
+  state->info.address = self.adopting_address.empty() ? peer_address(cl->sock) : self.adopting_address;
   state->info.websocket = cl->wsctx != nullptr;
   state->guard_fd = std::exchange(self.adopting_guard_fd, -1);
   cl->clientData = state;

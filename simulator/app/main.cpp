@@ -18,16 +18,19 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
+#include "app/frame_painter.hpp"
 #include "app/options.hpp"
+#include "app/session_setup.hpp"
 #include "app/simulation.hpp"
-#include "render/gl_renderer.hpp"
-#include "render/scene_builder.hpp"
+#include "app/study_session.hpp"
+#include "record/digest.hpp"
+#include "record/session_writer.hpp"
 #include "rfbsim/offscreen_gl.hpp"
 #include "rfbsim/server.hpp"
 #include "scenario/scenario.hpp"
-#include "world/demo_world.hpp"
 #include "world/fixed_step_clock.hpp"
 
 namespace {
@@ -64,22 +67,26 @@ void check_ready_fd(int fd) {
   }
 }
 
-// Tells the parent that the port is open: one line "ready <port>\n" on `fd`, which is then closed so that
-// the parent's read sees the end. Throws std::runtime_error when the write fails (EPIPE: the parent left).
-void report_ready(int fd, int port) {
-  const std::string line = "ready " + std::to_string(port) + "\n";
+// Writes one whole line to the parent's pipe. Returns the error in words, or "" when it was written.
+std::string write_line(int fd, const std::string& line) {
   std::size_t written = 0;
   while (written < line.size()) {
     const auto n = ::write(fd, line.data() + written, line.size() - written);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const std::string cause = n < 0 ? std::strerror(errno) : "nothing written";
-      ::close(fd);
-      throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": cannot write the ready line (" + cause + ")");
-    }
+    if (n <= 0) return n < 0 ? std::strerror(errno) : "nothing written";
     written += static_cast<std::size_t>(n);
   }
-  ::close(fd);
+  return "";
+}
+
+// Tells the parent that the port is open: one line "ready <port>\n" on `fd`. The pipe stays open for the
+// outcome line. Throws std::runtime_error when the write fails (EPIPE: the parent left).
+void report_ready(int fd, int port) {
+  const std::string error = write_line(fd, "ready " + std::to_string(port) + "\n");
+  if (!error.empty()) {
+    ::close(fd);
+    throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": cannot write the ready line (" + error + ")");
+  }
 }
 
 // The page: --web-root if given, else the one built beside this binary, else the installed one.
@@ -110,28 +117,43 @@ class StatusBoard {
   std::string text_ = "{}";
 };
 
-// The simulation the options ask for: a scenario with its overrides, or the built-in test room.
-std::unique_ptr<rfbsim::sim::Simulation> make_simulation(const rfbsim::sim::SimOptions& options) {
-  namespace sim = rfbsim::sim;
-  sim::SimulationParams params;
-  params.dt = 1.0 / options.tick_hz;
-  if (options.scenario.empty()) {
-    return std::make_unique<sim::Simulation>(params, sim::make_demo_world());
+// Viewers coming and going, told by the network thread and taken by the simulation thread, so that they
+// are recorded at a tick like every other input.
+class ClientChanges {
+ public:
+  struct Change {
+    bool connected = false;
+    rfbsim::ClientInfo client;
+  };
+  void push(bool connected, const rfbsim::ClientInfo& client) {
+    std::lock_guard lock(mutex_);
+    changes_.push_back({connected, client});
   }
-  const auto file = sim::find_scenario(options.scenario, {RFBSIM_SOURCE_SCENARIOS, RFBSIM_INSTALLED_SCENARIOS});
-  sim::Scenario scenario = sim::load_scenario(file);
-  sim::ScenarioOverrides overrides;
-  overrides.avatar_start = options.avatar_start;
-  overrides.avatar_goal = options.avatar_goal;
-  overrides.robot_start = options.robot_start;
-  overrides.robot_goal = options.robot_goal;
-  overrides.seed = options.seed;
-  overrides.crowd_count = options.crowd;
-  sim::apply_overrides(scenario, overrides);
-  std::fprintf(stderr, "[sim_rfb] scenario %s (%s), seed %llu, %d people\n", scenario.name.c_str(),
-               file.string().c_str(), static_cast<unsigned long long>(scenario.seed), scenario.crowd.count);
-  return std::make_unique<sim::Simulation>(params, sim::make_world(scenario), scenario.crowd,
-                                           sim::robot_setup(scenario));
+  std::vector<Change> take() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(changes_, {});
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<Change> changes_;
+};
+
+// What the command line asks to build.
+rfbsim::sim::SessionSetup setup_of(const rfbsim::sim::SimOptions& options) {
+  rfbsim::sim::SessionSetup setup;
+  setup.scenario = options.scenario;
+  setup.seed = options.seed;
+  setup.tick_hz = options.tick_hz;
+  if (options.time_limit) setup.time_limit = *options.time_limit;
+  const std::pair<const char*, const std::optional<std::string>*> poses[] = {
+      {"avatar_start", &options.avatar_start}, {"avatar_goal", &options.avatar_goal},
+      {"robot_start", &options.robot_start}, {"robot_goal", &options.robot_goal}};
+  for (const auto& [name, value] : poses) {
+    if (*value) setup.parameters.emplace_back(name, **value);
+  }
+  if (options.crowd) setup.parameters.emplace_back("crowd", std::to_string(*options.crowd));
+  return setup;
 }
 
 // The robot's state changes of the last tick, one log line each ("[robot] 12.35 s moving: ...").
@@ -148,8 +170,29 @@ int run(const rfbsim::sim::SimOptions& options) {
 
   if (options.ready_fd) check_ready_fd(*options.ready_fd);
   // The scenario first: a broken one ends the program before anything listens.
-  const std::unique_ptr<sim::Simulation> simulation_owner = make_simulation(options);
-  sim::Simulation& simulation = *simulation_owner;
+  sim::PreparedSession prepared = sim::prepare_session(setup_of(options));
+  sim::Simulation& simulation = *prepared.simulation;
+  if (!options.scenario.empty()) {
+    std::fprintf(stderr, "[sim_rfb] scenario %s (%s), seed %llu, %zu people\n", prepared.info.scenario.c_str(),
+                 prepared.info.scenario_file.c_str(), static_cast<unsigned long long>(prepared.info.seed),
+                 simulation.world().people.size());
+  }
+  // Session data from the first tick on, when asked for.
+  std::unique_ptr<sim::SessionWriter> writer;
+  if (!options.data_dir.empty()) {
+    sim::SessionInfo info = prepared.info;
+    info.uid = options.uid;
+    info.fps = options.fps;
+    info.trajectory_hz = options.trajectory_hz;
+    info.width = options.width;
+    info.height = options.height;
+    if (!options.code_success.empty() || !options.code_timeout.empty()) {
+      info.codes = std::make_pair(options.code_success, options.code_timeout);
+    }
+    writer = std::make_unique<sim::SessionWriter>(options.data_dir, std::move(info), simulation.world());
+  }
+  sim::StudySession study(simulation, prepared.task, {options.code_success, options.code_timeout}, writer.get());
+  const std::string address_key = sim::address_hash_key();
 
   StatusBoard status;
   rfbsim::ServerOptions server_options;
@@ -160,18 +203,22 @@ int run(const rfbsim::sim::SimOptions& options) {
   server_options.jpeg_quality = options.jpeg_quality;
   server_options.max_clients = options.max_clients;
   server_options.desktop_name = "rfbsim";
+  server_options.proxy_protocol = options.proxy_protocol;
   // RFB only: no web root and no route, which librfbsim takes to mean no HTTP at all, so that a raw RFB
   // client (sim_manager's relay) is served at once instead of after the wait that tells it from a browser.
   if (!options.rfb_only) {
     server_options.web_root = find_web_root(options.web_root);
     server_options.json_routes["/status.json"] = [&status] { return status.read(); };
   }
-  server_options.on_connect = [](const rfbsim::ClientInfo& c) {
+  ClientChanges client_changes;
+  server_options.on_connect = [&client_changes](const rfbsim::ClientInfo& c) {
     std::fprintf(stderr, "[sim_rfb] client %d connected from %s (%s)\n", c.id, c.address.c_str(),
                  c.websocket ? "websocket" : "rfb");
+    client_changes.push(true, c);
   };
-  server_options.on_disconnect = [](const rfbsim::ClientInfo& c) {
+  server_options.on_disconnect = [&client_changes](const rfbsim::ClientInfo& c) {
     std::fprintf(stderr, "[sim_rfb] client %d disconnected\n", c.id);
+    client_changes.push(false, c);
   };
   rfbsim::Server server(std::move(server_options));
 
@@ -180,7 +227,6 @@ int run(const rfbsim::sim::SimOptions& options) {
   gl_options.height = options.height;
   gl_options.platform = options.egl_platform;
   rfbsim::OffscreenGL gl(gl_options);
-  sim::GlRenderer renderer;
   std::fprintf(stderr, "[sim_rfb] rendering with %s\n", gl.renderer().c_str());
 
   sim::FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / options.tick_hz));
@@ -188,16 +234,13 @@ int run(const rfbsim::sim::SimOptions& options) {
   sim::SceneStyle scene_style;
   scene_style.debug_overlay = options.debug_overlay;
   std::uint64_t frames_rendered = 0;
-  std::optional<sim::Scene> last_drawn;  // the server keeps showing it; an equal scene is not drawn again
-  // Draws the world and hands the frame to the server, unless it would look the same as the last one.
+  sim::FramePainter painter(gl, scene_style);
+  // Draws the world and the HUD and hands the frame to the server, unless it would look as the last one (which
+  // the server keeps showing).
   const auto draw_if_changed = [&] {
-    sim::Scene scene = sim::build_scene(simulation.world(), scene_style);
-    if (last_drawn && sim::same_scene(scene, *last_drawn)) return;
-    gl.begin_frame();
-    renderer.draw(scene, gl.width(), gl.height());
+    if (!painter.paint(simulation.world(), study.text())) return;
     server.submit(gl.read_frame());
     ++frames_rendered;
-    last_drawn = std::move(scene);
   };
   // One frame before anyone watches, so that the first update a viewer gets is the scene, not black.
   draw_if_changed();
@@ -211,19 +254,48 @@ int run(const rfbsim::sim::SimOptions& options) {
 
   auto last = Clock::now();
   auto next_frame = last;
+  bool outcome_reported = false;
+  std::string end_reason = "signal";
   while (!g_stop) {
     const auto now = Clock::now();
     const int ticks = clock.advance(now - last);
     last = now;
 
-    // Input drained now takes effect from the next tick.
-    for (const rfbsim::InputEvent& event : server.poll_input()) {
-      if (event.kind == rfbsim::InputEvent::Kind::Key) simulation.apply_key(event.keysym, event.down);
+    // Viewers and input drained now are recorded at this tick and take effect from the next one.
+    for (const ClientChanges::Change& change : client_changes.take()) {
+      if (change.connected) {
+        study.client_connected(change.client.id, sim::hash_address(address_key, change.client.address),
+                               change.client.websocket);
+      } else {
+        study.client_disconnected(change.client.id);
+      }
     }
-    for (int i = 0; i < ticks; ++i) {
-      simulation.step();
+    for (const rfbsim::InputEvent& event : server.poll_input()) {
+      if (event.kind == rfbsim::InputEvent::Kind::Key) {
+        study.key(event.keysym, event.down, event.client_id);
+      } else {
+        study.pointer(event.x, event.y, event.buttons, event.client_id);
+      }
+    }
+    for (int i = 0; i < ticks && !study.over(); ++i) {
+      study.step();
       log_robot_events(simulation.world(), simulation.params().dt);
     }
+    // The outcome goes to the parent (sim_manager tells the survey) as soon as it is reached.
+    if (!outcome_reported && study.outcome() != sim::TaskOutcome::None) {
+      outcome_reported = true;
+      const char* outcome = sim::task_outcome_name(study.outcome());
+      std::fprintf(stderr, "[task] %.2f s outcome %s\n", simulation.world().time, outcome);
+      if (options.ready_fd) {
+        const std::string error = write_line(*options.ready_fd, std::string("outcome ") + outcome + "\n");
+        if (!error.empty()) std::fprintf(stderr, "[sim_rfb] cannot report the outcome to the parent: %s\n", error.c_str());
+      }
+    }
+    if (study.over()) {
+      end_reason = sim::task_outcome_name(study.outcome());
+      break;
+    }
+    if (writer) writer->flush_if_due();
     const int clients = server.client_count();
     if (ticks > 0 && !options.rfb_only) {
       status.publish(sim::status_json(simulation.world(), clients, frames_rendered));
@@ -241,9 +313,11 @@ int run(const rfbsim::sim::SimOptions& options) {
     if (clients > 0) wake = std::min(wake, next_frame);
     std::this_thread::sleep_until(wake);
   }
-  std::fprintf(stderr, "[sim_rfb] stopping after %llu ticks, %llu frames\n",
+  study.finish(end_reason);
+  if (options.ready_fd) ::close(*options.ready_fd);
+  std::fprintf(stderr, "[sim_rfb] stopping after %llu ticks, %llu frames (%s)\n",
                static_cast<unsigned long long>(simulation.world().tick),
-               static_cast<unsigned long long>(frames_rendered));
+               static_cast<unsigned long long>(frames_rendered), end_reason.c_str());
   return 0;
 }
 

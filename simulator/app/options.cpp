@@ -21,6 +21,16 @@ bool parse_number(const std::string& text, T low, T high, T& out) {
   return true;
 }
 
+// Participant ids and completion codes: safe in file names, logs and the HUD.
+bool is_identifier(const std::string& text) {
+  if (text.empty() || text.size() > 64) return false;
+  for (const char c : text) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
+    if (!ok) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::string sim_usage() {
@@ -28,7 +38,9 @@ std::string sim_usage() {
          "               [--scenario NAME|PATH] [--avatar-start P] [--avatar-goal P] [--robot-start P]\n"
          "               [--robot-goal P] [--crowd N]\n"
          "               [--quality Q] [--max-clients N] [--web-root DIR] [--egl auto|device|surfaceless]\n"
-         "               [--debug-overlay] [--rfb-only] [--ready-fd N]\n"
+         "               [--debug-overlay] [--rfb-only] [--proxy-protocol] [--ready-fd N]\n"
+         "               [--data-dir DIR] [--uid ID] [--code-success C] [--code-timeout C]\n"
+         "               [--time-limit S] [--trajectory-hz N]\n"
          "  --port N         TCP port for the page, WebSocket and RFB (default 5901; 0 = any free port)\n"
          "  --bind ADDR      numeric address to listen on (default 127.0.0.1)\n"
          "  --width W        frame width in pixels, 160..3840 (default 1280)\n"
@@ -47,8 +59,21 @@ std::string sim_usage() {
          "                   cost on the floor (for developers; participants should not see it)\n"
          "  --rfb-only       serve RFB only (raw and over WebSocket): no page, no /status.json; a raw RFB\n"
          "                   client is then served at once instead of after 0.5 s (for sim_manager's relay)\n"
+         "  --proxy-protocol each connection begins with a PROXY protocol v1 line naming the real client,\n"
+         "                   as sim_manager's relay sends it (for a trusted relay only: never on a port\n"
+         "                   that others reach)\n"
          "  --ready-fd N     once listening, write 'ready PORT' and a newline to file descriptor N (3 or\n"
-         "                   above, e.g. a pipe from the parent) and close it; exit 1 if that write fails\n";
+         "                   above, e.g. a pipe from the parent) and keep it open: later lines report the\n"
+         "                   task's outcome ('outcome completed' or 'outcome timeout'); exit 1 if the ready\n"
+         "                   line cannot be written\n"
+         "  --data-dir DIR   record the session there: session.json, trajectories.csv, events.jsonl\n"
+         "                   (docs/data.md); without it nothing is recorded\n"
+         "  --uid ID         participant id recorded in session.json (letters, digits, - and _)\n"
+         "  --code-success C, --code-timeout C\n"
+         "                   completion codes shown when the task is done or the time is up (1..64 of\n"
+         "                   letters, digits, - and _; SEAN-EP's t1 and t2)\n"
+         "  --time-limit S   the task's time limit in seconds, 1..86400 (default: the scenario's)\n"
+         "  --trajectory-hz N  trajectory rows per second, a divisor of the tick rate 60 (default 10)\n";
 }
 
 ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
@@ -88,6 +113,19 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
          o.ready_fd = fd;
          return true;
        }},
+      {"--data-dir", [&](const std::string& v) { o.data_dir = v; return !v.empty(); }},
+      {"--uid", [&](const std::string& v) { o.uid = v; return is_identifier(v); }},
+      {"--code-success", [&](const std::string& v) { o.code_success = v; return is_identifier(v); }},
+      {"--code-timeout", [&](const std::string& v) { o.code_timeout = v; return is_identifier(v); }},
+      {"--time-limit", [&](const std::string& v) {
+         int seconds = 0;
+         if (!parse_number(v, 1, 86400, seconds)) return false;
+         o.time_limit = seconds;
+         return true;
+       }},
+      {"--trajectory-hz", [&](const std::string& v) {
+         return parse_number(v, 1, 60, o.trajectory_hz) && 60 % o.trajectory_hz == 0;
+       }},
       {"--egl", [&](const std::string& v) {
          o.egl_platform = v;
          return v == "auto" || v == "device" || v == "surfaceless";
@@ -105,6 +143,10 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
     }
     if (arg == "--rfb-only") {
       o.rfb_only = true;
+      continue;
+    }
+    if (arg == "--proxy-protocol") {
+      o.proxy_protocol = true;
       continue;
     }
     auto option = with_value.find(arg);

@@ -29,8 +29,17 @@ struct SimOptions {
   bool debug_overlay = false;       ///< draw the robot's path, trajectory, goal and social cost (for developers)
   /// Serve RFB only (raw and over WebSocket): no page, no /status.json, no web root looked for.
   bool rfb_only = false;
-  /// Once listening, write "ready <port>\n" to this file descriptor (3 or above) and close it.
+  /// Each connection begins with a PROXY protocol line naming the real client (sim_manager's relay).
+  bool proxy_protocol = false;
+  /// Once listening, write "ready <port>\n" to this file descriptor (3 or above), then one line per
+  /// outcome ("outcome completed\n"); closed when the program ends.
   std::optional<int> ready_fd;
+  std::string data_dir;             ///< record session data here (docs/data.md); empty = nothing recorded
+  std::string uid;                  ///< participant id for session.json
+  std::string code_success;         ///< completion code shown on success (SEAN-EP's t1); empty = none
+  std::string code_timeout;         ///< completion code shown on timeout (t2); empty = none
+  std::optional<int> time_limit;    ///< s, the task's time limit instead of the scenario's
+  int trajectory_hz = 10;           ///< trajectory rows per second; divides tick_hz
   bool help = false;
 };
 

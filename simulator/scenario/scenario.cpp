@@ -9,6 +9,7 @@
 
 #include "map/map_server_loader.hpp"
 #include "scenario/robot_params_yaml.hpp"
+#include "scenario/task_yaml.hpp"
 #include "scenario/yaml_field.hpp"
 
 namespace rfbsim::sim {
@@ -271,7 +272,7 @@ Pose2 resolve_override(const Scenario& scenario, const std::string& option, cons
 Scenario load_scenario(const std::filesystem::path& file) {
   const YamlField root = read_yaml_file(file);
   if (!root.is_mapping()) root.fail("a mapping of scenario keys");
-  root.allow_only({"name", "description", "map", "seed", "props", "landmarks", "spawns", "crowd", "robot", "avatar"});
+  root.allow_only({"name", "description", "map", "seed", "props", "landmarks", "spawns", "crowd", "robot", "avatar", "task"});
   Scenario scenario;
   scenario.file = file;
   scenario.name = root.optional("name") ? root.required("name").text() : file.stem().string();
@@ -281,7 +282,9 @@ Scenario load_scenario(const std::filesystem::path& file) {
   scenario.map_file = map_field.text();
   if (scenario.map_file.is_relative()) scenario.map_file = file.parent_path() / scenario.map_file;
   try {
-    scenario.map = load_ros_map(scenario.map_file).grid;
+    LoadedMap loaded = load_ros_map(scenario.map_file);
+    scenario.map_image = loaded.meta.image;
+    scenario.map = std::move(loaded.grid);
   } catch (const MapLoadError& e) {
     map_field.fail_with(e.what());
   }
@@ -324,6 +327,14 @@ Scenario load_scenario(const std::filesystem::path& file) {
     }
   }
   if (auto crowd = root.optional("crowd")) parse_crowd(scenario, obstacles, *crowd, seed_given);
+  if (auto task = root.optional("task")) {
+    scenario.task = parse_task(*task, scenario.landmarks);
+    try {
+      resolve_task_targets(scenario.task, scenario.landmarks, scenario.avatar_goal ? &*scenario.avatar_goal : nullptr);
+    } catch (const ScenarioError& e) {
+      task->fail_with(e.what());
+    }
+  }
   return scenario;
 }
 
@@ -381,6 +392,8 @@ void apply_overrides(Scenario& scenario, const ScenarioOverrides& overrides) {
     std::string name;
     const Pose2 goal = checked("--avatar-goal", *overrides.avatar_goal, 0.05, &name);
     scenario.avatar_goal = goal_landmark(goal, name);
+    // Reach steps without a landmark of their own go to the goal the link gave.
+    resolve_task_targets(scenario.task, scenario.landmarks, &*scenario.avatar_goal);
   }
   if (overrides.robot_start || overrides.robot_goal) {
     if (!scenario.robot.present) throw ScenarioError("--robot-start/--robot-goal: scenario " + scenario.name + " has no robot");

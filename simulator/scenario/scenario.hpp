@@ -15,6 +15,7 @@
 #include "crowd/crowd_spec.hpp"
 #include "robot/mission.hpp"
 #include "robot/robot_stack.hpp"
+#include "task/task_spec.hpp"
 #include "world/world.hpp"
 
 namespace rfbsim::sim {
@@ -42,6 +43,7 @@ struct Scenario {
   std::string name;                 ///< the file's `name`, else its stem
   std::filesystem::path file;       ///< where it was loaded from
   std::filesystem::path map_file;   ///< the ROS map YAML
+  std::filesystem::path map_image;  ///< the map's picture (what session data's map_sha256 is taken of)
   GridMap map;                      ///< walls from the map file
   std::vector<Prop> props;
   std::vector<Landmark> landmarks;
@@ -51,6 +53,7 @@ struct Scenario {
   Pose2 avatar_start;
   std::optional<Landmark> avatar_goal;  ///< drawn as a landmark; what the participant walks to
   std::uint64_t seed = 1;               ///< master seed; the crowd's comes from it unless given
+  TaskSpec task;                        ///< the participant's task; no steps = none (reach targets resolved)
 };
 
 /// Loads and checks a scenario file and its map. Throws ScenarioError (never anything else for bad

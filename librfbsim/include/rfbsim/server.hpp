@@ -74,6 +74,12 @@ struct ServerOptions {
   /// Extra JSON endpoints on the same port, e.g. {"/status.json", fn}; fn runs on an HTTP worker thread
   /// and returns the body. Paths must start with '/'. Empty, and with no web_root: RFB only (see web_root).
   std::map<std::string, std::function<std::string()>> json_routes;
+  /// Every connection must begin with a PROXY protocol version 1 line (HAProxy's), whose source address
+  /// becomes the client's ClientInfo::address. For a trusted relay in front of the server, such as
+  /// sim_manager's, so that the server knows the participant's address rather than the relay's. A
+  /// connection without a valid line within read_timeout is closed. Never enable it on a port that
+  /// untrusted peers reach directly: they could claim any address.
+  bool proxy_protocol = false;
 };
 
 /// Serves frames over RFB (raw TCP) and RFB-over-WebSocket on one port, plus optional static files and

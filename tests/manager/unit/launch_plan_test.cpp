@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include "launch_plan.hpp"
 
 using rfbsim::manager::LaunchContext;
@@ -23,11 +25,29 @@ StartRequest request(const std::string& scenario) {
 
 }  // namespace
 
-TEST_CASE("sim_rfb gets its fixed flags, the scenario and the seed") {
+TEST_CASE("sim_rfb gets its fixed flags, the scenario, the seed and where to record the session") {
   ManagerConfig config;
   const LaunchContext context{7, 0, "/data/p01-1"};
   CHECK(session_arguments(config, request("lab"), context) ==
-        Args{"--port", "0", "--bind", "127.0.0.1", "--rfb-only", "--ready-fd", "3", "--scenario", "lab", "--seed", "7"});
+        Args{"--port", "0", "--bind", "127.0.0.1", "--rfb-only", "--ready-fd", "3", "--scenario", "lab", "--seed", "7",
+             "--proxy-protocol", "--data-dir", "/data/p01-1", "--uid", "p01"});
+}
+
+TEST_CASE("sim_rfb gets the link's completion codes, each only when the link has it") {
+  ManagerConfig config;
+  const LaunchContext context{7, 0, "/data/p01-1"};
+  StartRequest r = request("lab");
+  r.code_success = "OK-123";
+  r.code_timeout = "LATE_9";
+  Args args = session_arguments(config, r, context);
+  CHECK(Args(args.end() - 4, args.end()) == Args{"--code-success", "OK-123", "--code-timeout", "LATE_9"});
+  r.code_success.clear();
+  args = session_arguments(config, r, context);
+  CHECK(Args(args.end() - 2, args.end()) == Args{"--code-timeout", "LATE_9"});
+  CHECK(std::find(args.begin(), args.end(), "--code-success") == args.end());
+  CHECK(parameters_json(request("lab"), 7).find("t1") == std::string::npos);
+  r.code_success = "OK-123";
+  CHECK(parameters_json(r, 7) == R"({"uid":"p01","scenario":"lab","seed":"7","t1":"OK-123","t2":"LATE_9"})");
 }
 
 TEST_CASE("sim_rfb gets one flag per override, then the configured extra arguments") {
@@ -54,6 +74,11 @@ TEST_CASE("sim_rfb gets one flag per override, then the configured extra argumen
                                                        "dock",
                                                        "--crowd",
                                                        "12",
+                                                       "--proxy-protocol",
+                                                       "--data-dir",
+                                                       "/data/p01-1",
+                                                       "--uid",
+                                                       "p01",
                                                        "--width",
                                                        "1280",
                                                        "--fps=30"});

@@ -55,9 +55,29 @@ TEST_CASE("an ending session is shown as the state it is ending into") {
 TEST_CASE("the status poll gives the state, what it ends as, and the seconds since the link") {
   Session s = sample();
   const auto now = s.created + std::chrono::milliseconds(1500);
-  CHECK(rfbsim::manager::status_json(s, now) == R"({"state":"running","ends_as":"running","elapsed_s":1.500})");
+  CHECK(rfbsim::manager::status_json(s, now, {}) ==
+        R"({"state":"running","ends_as":"running","elapsed_s":1.500,"uid":"p-01","outcome":null,"code":null,)"
+        R"("survey_origins":[]})");
   REQUIRE(rfbsim::manager::begin_ending(s, SessionState::kEnded, "admin"));
-  CHECK(rfbsim::manager::status_json(s, now) == R"({"state":"ending","ends_as":"ended","elapsed_s":1.500})");
+  CHECK(rfbsim::manager::status_json(s, now, {}) ==
+        R"({"state":"ending","ends_as":"ended","elapsed_s":1.500,"uid":"p-01","outcome":null,"code":null,)"
+        R"("survey_origins":[]})");
+}
+
+TEST_CASE("the status poll gives the outcome with the code the link carried for it, and the survey origins") {
+  Session s = sample();
+  s.code_success = "DONE-1";
+  s.code_timeout = "LATE-2";
+  const auto now = s.created + std::chrono::milliseconds(1500);
+  const std::vector<std::string> origins = {"https://survey.example", "https://x.example"};
+  s.outcome = "completed";
+  CHECK(rfbsim::manager::status_json(s, now, origins) ==
+        R"({"state":"running","ends_as":"running","elapsed_s":1.500,"uid":"p-01","outcome":"completed",)"
+        R"("code":"DONE-1","survey_origins":["https://survey.example","https://x.example"]})");
+  s.outcome = "timeout";
+  CHECK(rfbsim::manager::status_json(s, now, {}).find(R"("outcome":"timeout","code":"LATE-2")") != std::string::npos);
+  s.code_timeout.clear();
+  CHECK(rfbsim::manager::status_json(s, now, {}).find(R"("outcome":"timeout","code":null)") != std::string::npos);
 }
 
 TEST_CASE("the admin API's session JSON names every field, and the token only when asked") {
@@ -66,7 +86,7 @@ TEST_CASE("the admin API's session JSON names every field, and the token only wh
   const std::string expected =
       R"({"id":7,"uid":"p-01","scenario":"lab","seed":"42","state":"running","detail":"said \"hi\"",)"
       R"("exit_status":"","created_at":"2026-11-24T10:00:00.000Z","ready_at":"2026-11-24T10:00:00.250Z",)"
-      R"("ended_at":null,"data_path":"/data/sessions/7-p-01","params":{"uid":"p-01","scenario":"lab","seed":"42"})";
+      R"("ended_at":null,"data_path":"/data/sessions/7-p-01","outcome":null,"params":{"uid":"p-01","scenario":"lab","seed":"42"})";
   CHECK(rfbsim::manager::session_json(s, false) == expected + "}");
   CHECK(rfbsim::manager::session_json(s, true) == expected + R"(,"token":"0123456789abcdef0123456789abcdef"})");
 }

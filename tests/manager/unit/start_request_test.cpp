@@ -273,3 +273,17 @@ TEST_CASE("a link naming a NAME=FILE scenario by its name is accepted") {
   CHECK_FALSE(parse_start_request({{"uid", "p01"}, {"scenario", "lab=/srv/lab.yaml"}}, scenario_names(entries))
                   .request);
 }
+
+TEST_CASE("completion codes t1 and t2 are identifiers, kept apart from the scenario overrides") {
+  const StartParse parsed =
+      parse_start_request({{"uid", "p01"}, {"t1", "C1A2B3"}, {"t2", "T-9_x"}, {"crowd", "2"}}, kScenarios);
+  REQUIRE(parsed.request);
+  CHECK(parsed.request->code_success == "C1A2B3");
+  CHECK(parsed.request->code_timeout == "T-9_x");
+  CHECK(parsed.request->overrides == std::vector<std::pair<std::string, std::string>>{{"crowd", "2"}});
+  CHECK_FALSE(accepted("t1", "a b"));
+  CHECK_FALSE(accepted("t2", "<script>"));
+  CHECK_FALSE(accepted("t1", ""));
+  CHECK_FALSE(accepted("t2", std::string(65, 'x')));
+  CHECK(parse_with("t1", "x;rm").error.find("t1") != std::string::npos);
+}

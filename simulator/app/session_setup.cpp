@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// SessionSetup: from a scenario and its parameters to a running Simulation.
+#include "app/session_setup.hpp"
+
+#include <charconv>
+
+#include "record/digest.hpp"
+#include "scenario/scenario.hpp"
+#include "world/demo_world.hpp"
+
+namespace rfbsim::sim {
+
+namespace {
+
+ScenarioOverrides overrides_of(const SessionSetup& setup) {
+  ScenarioOverrides overrides;
+  overrides.seed = setup.seed;
+  for (const auto& [name, value] : setup.parameters) {
+    if (name == "avatar_start") {
+      overrides.avatar_start = value;
+    } else if (name == "avatar_goal") {
+      overrides.avatar_goal = value;
+    } else if (name == "robot_start") {
+      overrides.robot_start = value;
+    } else if (name == "robot_goal") {
+      overrides.robot_goal = value;
+    } else if (name == "crowd") {
+      int count = -1;
+      const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), count);
+      if (ec != std::errc() || end != value.data() + value.size()) {
+        throw ScenarioError("--crowd: expected a number of people, got '" + value + "'");
+      }
+      overrides.crowd_count = count;
+    } else {
+      throw ScenarioError("unknown scenario parameter '" + name + "'");
+    }
+  }
+  return overrides;
+}
+
+}  // namespace
+
+const char* rfbsim_version() { return RFBSIM_VERSION; }
+const char* rfbsim_build_id() { return RFBSIM_BUILD_ID; }
+
+PreparedSession prepare_session(const SessionSetup& setup) {
+  SimulationParams params;
+  params.dt = 1.0 / setup.tick_hz;
+  PreparedSession prepared;
+  SessionInfo& info = prepared.info;
+  info.tick_hz = setup.tick_hz;
+  info.parameters = setup.parameters;
+  info.rfbsim_version = rfbsim_version();
+  info.build = rfbsim_build_id();
+  if (setup.scenario.empty()) {
+    if (!setup.parameters.empty()) throw ScenarioError("the built-in test room takes no scenario parameters");
+    prepared.simulation = std::make_unique<Simulation>(params, make_demo_world());
+    return prepared;
+  }
+  const auto file = find_scenario(setup.scenario, {RFBSIM_SOURCE_SCENARIOS, RFBSIM_INSTALLED_SCENARIOS});
+  Scenario scenario = load_scenario(file);
+  apply_overrides(scenario, overrides_of(setup));
+  if (setup.time_limit) scenario.task.time_limit = *setup.time_limit;
+
+  info.scenario = scenario.name;
+  info.scenario_file = std::filesystem::absolute(file).lexically_normal().string();
+  info.seed = scenario.seed;
+  info.scenario_sha256 = sha256_file(file);
+  info.map_sha256 = sha256_file(scenario.map_image);
+  for (const TaskStep& step : scenario.task.steps) info.tasks.emplace_back(task_type_name(step.type), task_step_text(step));
+  if (!scenario.task.steps.empty()) info.time_limit = scenario.task.time_limit;
+  prepared.task = scenario.task;
+  prepared.simulation = std::make_unique<Simulation>(params, make_world(scenario), scenario.crowd, robot_setup(scenario));
+  return prepared;
+}
+
+}  // namespace rfbsim::sim

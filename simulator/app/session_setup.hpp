@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// SessionSetup: what makes one session's world (scenario, overrides, seed, rates), and the Simulation,
+// task and session-data header made from it. sim_rfb makes it from its command line; sim_replay from a
+// recorded session.json, so that both build the very same world.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "app/simulation.hpp"
+#include "record/session_writer.hpp"
+#include "task/task_spec.hpp"
+
+namespace rfbsim::sim {
+
+struct SessionSetup {
+  std::string scenario;  ///< name or path; empty = the built-in test room
+  /// Overrides as (link parameter, value): avatar_start, avatar_goal, robot_start, robot_goal, crowd.
+  std::vector<std::pair<std::string, std::string>> parameters;
+  std::optional<std::uint64_t> seed;  ///< unset = the scenario's
+  int tick_hz = 60;
+  std::optional<double> time_limit;  ///< s, overrides the scenario's task time limit
+};
+
+/// A session ready to run.
+struct PreparedSession {
+  std::unique_ptr<Simulation> simulation;
+  TaskSpec task;
+  SessionInfo info;  ///< session.json's header, less what the caller knows (uid, fps, frame, codes)
+};
+
+/// Loads the scenario (found by name in the source and installed scenario folders, or as a path),
+/// applies the parameters, and builds everything. Throws ScenarioError for a bad scenario or parameter.
+PreparedSession prepare_session(const SessionSetup& setup);
+
+/// This build's version and build id, as session.json's `versions` records them.
+const char* rfbsim_version();
+const char* rfbsim_build_id();
+
+}  // namespace rfbsim::sim

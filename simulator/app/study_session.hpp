@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// StudySession: one participant's session around a Simulation: inputs and viewers in (recorded at the
+// tick they are applied), then per tick the simulation, the task monitor and the session data. sim_rfb
+// drives it live; sim_replay drives it from a log, so that both take the same path through the same code.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "app/simulation.hpp"
+#include "record/session_writer.hpp"
+#include "task/task_display.hpp"
+#include "task/task_monitor.hpp"
+
+namespace rfbsim::sim {
+
+/// The completion codes a link carried (SEAN-EP's t1 and t2); empty = none to show.
+struct StudyCodes {
+  std::string success;
+  std::string timeout;
+};
+
+class StudySession {
+ public:
+  /// `writer` may be null (nothing recorded); both `simulation` and `writer` must outlive this.
+  StudySession(Simulation& simulation, TaskSpec task, StudyCodes codes, SessionWriter* writer);
+
+  /// A key event; it takes effect from the next step. `client` 0: librfbsim releasing a leaver's keys.
+  void key(std::uint32_t keysym, bool down, int client);
+  /// Pointer moves and buttons: recorded, not used.
+  void pointer(int x, int y, int buttons, int client);
+  /// A viewer arrived: recorded with its hashed address; the first one starts the task's clock.
+  void client_connected(int client, const std::string& address_hash, bool websocket);
+  void client_disconnected(int client);
+
+  /// One tick: simulation, task, then the tick's trajectory sample and events.
+  void step();
+
+  /// The outcome was reached and its grace period has passed: the session should end.
+  [[nodiscard]] bool over() const;
+  [[nodiscard]] TaskOutcome outcome() const { return monitor_.outcome(); }
+  /// The code for the outcome reached (empty without outcome or without codes).
+  [[nodiscard]] std::string outcome_code() const;
+  /// What the HUD shows now.
+  [[nodiscard]] TaskText text() const { return task_text(monitor_.spec(), monitor_.status(), outcome_code()); }
+  [[nodiscard]] const TaskMonitor& task() const { return monitor_; }
+  [[nodiscard]] const Simulation& simulation() const { return simulation_; }
+
+  /// Records the end (a `session` event and session.json's end keys). `reason`: completed, timeout,
+  /// signal or error.
+  void finish(const std::string& reason);
+
+ private:
+  void record_task_events();
+
+  Simulation& simulation_;
+  TaskMonitor monitor_;
+  StudyCodes codes_;
+  SessionWriter* writer_;
+};
+
+}  // namespace rfbsim::sim

@@ -1,0 +1,239 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// SessionWriter: session.json, trajectories.csv and events.jsonl.
+#include "record/session_writer.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <stdexcept>
+
+namespace rfbsim::sim {
+
+namespace {
+
+constexpr std::size_t kBufferLimit = 256 * 1024;  // bytes: written at once above this, whatever the clock
+
+[[noreturn]] void fail(const std::filesystem::path& path, const char* what) {
+  throw std::runtime_error(path.string() + ": " + what + " (" + std::strerror(errno) + ")");
+}
+
+int open_append(const std::filesystem::path& path) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0) fail(path, "cannot open for writing");
+  return fd;
+}
+
+void write_all(int fd, const std::string& bytes, const std::filesystem::path& path) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) fail(path, "cannot write");
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+const char* party_name(Party party) {
+  switch (party) {
+    case Party::Avatar: return "avatar";
+    case Party::Person: return "person";
+    case Party::Robot: return "robot";
+    case Party::Static: return "static";
+  }
+  return "unknown";
+}
+
+// Ids as in trajectories.csv: the person's own id, 0 for the others.
+int party_id(const World& world, Party party, int index) {
+  if (party != Party::Person || index < 0 || static_cast<std::size_t>(index) >= world.people.size()) return 0;
+  return world.people[static_cast<std::size_t>(index)].id;
+}
+
+// Six decimals, with -0.000000 written as 0.000000: a replay compares the text, and a sign that rounds
+// away must not make two equal poses differ.
+double printable(double value) { return std::abs(value) < 5e-7 ? 0.0 : value; }
+
+void append_row(std::string& out, std::uint64_t tick, double time, const char* kind, int id, const Pose2& pose,
+                const Eigen::Vector2d& velocity) {
+  char row[256];
+  std::snprintf(row, sizeof row, "%llu,%.6f,%s,%d,%.6f,%.6f,%.6f,%.6f,%.6f\n", static_cast<unsigned long long>(tick),
+                time, kind, id, printable(pose.x), printable(pose.y), printable(pose.yaw), printable(velocity.x()),
+                printable(velocity.y()));
+  out += row;
+}
+
+}  // namespace
+
+std::string iso_utc_now() {
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
+  const auto millis =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char text[80];
+  std::snprintf(text, sizeof text, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", utc.tm_year + 1900, utc.tm_mon + 1,
+                utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec, static_cast<int>(millis));
+  return text;
+}
+
+SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const World& world,
+                             std::chrono::milliseconds flush_interval)
+    : dir_(std::move(dir)), info_(std::move(info)), flush_interval_(flush_interval) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) throw std::runtime_error(dir_.string() + ": cannot create the session folder (" + ec.message() + ")");
+  if (info_.trajectory_hz < 1 || info_.tick_hz % info_.trajectory_hz != 0) {
+    throw std::runtime_error("trajectory rate " + std::to_string(info_.trajectory_hz) + " Hz must divide the tick rate " +
+                             std::to_string(info_.tick_hz) + " Hz");
+  }
+  sample_every_ = static_cast<std::uint64_t>(info_.tick_hz / info_.trajectory_hz);
+
+  using json = nlohmann::ordered_json;
+  json parameters = json::object();
+  for (const auto& [name, value] : info_.parameters) parameters[name] = value;
+  json agents = json::array();
+  agents.push_back({{"kind", "avatar"}, {"id", 0}, {"radius", world.avatar.radius}});
+  if (world.robot) agents.push_back({{"kind", "robot"}, {"id", 0}, {"radius", world.robot->radius}});
+  for (const Person& p : world.people) agents.push_back({{"kind", "person"}, {"id", p.id}, {"radius", p.radius}});
+  json tasks = json::array();
+  for (const auto& [type, text] : info_.tasks) tasks.push_back({{"type", type}, {"text", text}});
+  session_ = {{"format", "rfbsim-session/1"},
+              {"uid", info_.uid},
+              {"scenario", info_.scenario},
+              {"scenario_file", info_.scenario_file},
+              {"parameters", parameters},
+              {"seed", std::to_string(info_.seed)},
+              {"tick_hz", info_.tick_hz},
+              {"fps", info_.fps},
+              {"trajectory_hz", info_.trajectory_hz},
+              {"frame", {{"width", info_.width}, {"height", info_.height}}},
+              {"versions",
+               {{"rfbsim", info_.rfbsim_version},
+                {"build", info_.build},
+                {"scenario_sha256", info_.scenario_sha256},
+                {"map_sha256", info_.map_sha256}}},
+              {"agents", agents},
+              {"tasks", tasks},
+              {"time_limit_s", info_.time_limit ? json(*info_.time_limit) : json(nullptr)},
+              {"codes", info_.codes ? json{{"success", info_.codes->first}, {"timeout", info_.codes->second}}
+                                    : json(nullptr)},
+              {"started_at", iso_utc_now()},
+              {"ended_at", nullptr},
+              {"end_tick", nullptr},
+              {"end_reason", nullptr},
+              {"outcome", nullptr},
+              {"completion", nullptr},
+              {"tasks_done", json::array()}};
+  write_session_json();
+
+  trajectory_fd_ = open_append(dir_ / "trajectories.csv");
+  events_fd_ = open_append(dir_ / "events.jsonl");
+  trajectory_buffer_ = "tick,time,kind,id,x,y,yaw,vx,vy\n";
+  last_flush_ = std::chrono::steady_clock::now();
+  flush();
+}
+
+SessionWriter::~SessionWriter() {
+  try {
+    flush();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "[record] %s\n", e.what());
+  }
+  if (trajectory_fd_ >= 0) ::close(trajectory_fd_);
+  if (events_fd_ >= 0) ::close(events_fd_);
+}
+
+void SessionWriter::sample(const World& world) {
+  if (world.tick % sample_every_ != 0) return;
+  const double time = time_of(world.tick);
+  append_row(trajectory_buffer_, world.tick, time, "avatar", 0, world.avatar.pose,
+             Eigen::Vector2d(std::cos(world.avatar.pose.yaw), std::sin(world.avatar.pose.yaw)) * world.avatar.speed);
+  if (world.robot) append_row(trajectory_buffer_, world.tick, time, "robot", 0, world.robot->pose, world.robot->velocity);
+  for (const Person& p : world.people) append_row(trajectory_buffer_, world.tick, time, "person", p.id, p.pose, p.velocity);
+}
+
+void SessionWriter::event(std::uint64_t tick, const char* type, const nlohmann::ordered_json& fields) {
+  nlohmann::ordered_json line = {{"tick", tick}, {"time", time_of(tick)}, {"type", type}};
+  for (const auto& [key, value] : fields.items()) line[key] = value;
+  // Strings from outside (robot details, task texts) may hold any bytes: replace what is not UTF-8
+  // rather than throw in the middle of a session.
+  events_buffer_ += line.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  events_buffer_ += '\n';
+}
+
+void SessionWriter::world_events(const World& world) {
+  for (const ContactEvent& c : world.contacts) {
+    event(c.tick, "contact",
+          {{"a", party_name(c.a)}, {"a_id", party_id(world, c.a, c.a_index)}, {"b", party_name(c.b)},
+           {"b_id", party_id(world, c.b, c.b_index)}, {"impulse", c.impulse}});
+  }
+  for (const RobotEvent& r : world.robot_events) {
+    event(r.tick, "robot", {{"state", robot_state_name(r.state)}, {"detail", r.detail}});
+  }
+}
+
+void SessionWriter::task_done(const std::string& type, std::uint64_t tick) {
+  session_["tasks_done"].push_back({{"type", type}, {"tick", tick}, {"time", time_of(tick)}});
+  write_session_json();
+}
+
+void SessionWriter::outcome(const std::string& outcome, const std::string& code, std::uint64_t tick) {
+  session_["outcome"] = outcome;
+  session_["completion"] = {{"code", code}, {"tick", tick}, {"time", time_of(tick)}};
+  write_session_json();
+  flush();  // the outcome is what a study needs most: on disk now, not in half a second
+}
+
+void SessionWriter::finish(const SessionEnd& end) {
+  session_["ended_at"] = iso_utc_now();
+  session_["end_tick"] = end.tick;
+  session_["end_reason"] = end.reason;
+  flush();
+  write_session_json();
+}
+
+void SessionWriter::flush_if_due() {
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_flush_ >= flush_interval_ || trajectory_buffer_.size() + events_buffer_.size() > kBufferLimit) {
+    flush();
+  }
+}
+
+void SessionWriter::flush() {
+  last_flush_ = std::chrono::steady_clock::now();
+  // Whole lines per write: a kill between two writes leaves every line complete.
+  if (!trajectory_buffer_.empty()) {
+    write_all(trajectory_fd_, trajectory_buffer_, dir_ / "trajectories.csv");
+    trajectory_buffer_.clear();
+  }
+  if (!events_buffer_.empty()) {
+    write_all(events_fd_, events_buffer_, dir_ / "events.jsonl");
+    events_buffer_.clear();
+  }
+}
+
+void SessionWriter::write_session_json() {
+  // Write a temporary file, sync it, rename it over: a reader (or a crash) sees the old or the new
+  // document, never half of one.
+  const std::filesystem::path target = dir_ / "session.json";
+  const std::filesystem::path temporary = dir_ / "session.json.tmp";
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail(temporary, "cannot open for writing");
+  try {
+    write_all(fd, session_.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n", temporary);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  ::fdatasync(fd);
+  ::close(fd);
+  if (::rename(temporary.c_str(), target.c_str()) != 0) fail(target, "cannot replace");
+}
+
+}  // namespace rfbsim::sim

@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// GroupSummary: rates and statistics per group of sessions.
+#include "group_summary.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include "report_columns.hpp"
+
+namespace rfbsim::report {
+
+namespace {
+
+GroupSummary summarize_group(const std::vector<const SessionMetrics*>& group) {
+  GroupSummary out;
+  out.sessions = group.size();
+  for (const Rate& rate : summary_rates()) {
+    const auto yes = std::count_if(group.begin(), group.end(), [&](const SessionMetrics* m) { return rate.holds(*m); });
+    const double n = static_cast<double>(group.size());
+    out.rate_percent.push_back(group.empty() ? 0.0 : 100.0 * static_cast<double>(yes) / n);
+  }
+  for (const std::string& name : summarized_columns()) {
+    const Column& column = session_column(name);
+    std::vector<double> values;
+    for (const SessionMetrics* m : group) {
+      if (const auto v = numeric_value(column.value(*m))) values.push_back(*v);
+    }
+    out.statistics.push_back(statistic_of(std::move(values)));
+  }
+  return out;
+}
+
+}  // namespace
+
+const std::vector<Rate>& summary_rates() {
+  using M = SessionMetrics;
+  static const std::vector<Rate> rates = {
+      {"timed_out", "timed out", [](const M& m) { return m.timed_out; }},
+      {"completed", "completed", [](const M& m) { return m.completed; }},
+      {"never_moved", "never moved", [](const M& m) { return m.never_moved; }},
+      {"found_robot", "found the robot", [](const M& m) { return m.found_robot; }},
+      {"robot_within_0_45", "robot within 0.45 m", [](const M& m) { return m.robot_within_0_45; }},
+      {"robot_within_1_2", "robot within 1.2 m", [](const M& m) { return m.robot_within_1_2; }},
+      {"avatar_pushed_robot", "avatar pushed the robot", [](const M& m) { return m.avatar_pushed_robot; }},
+      {"avatar_person_collision", "avatar-person collision", [](const M& m) { return m.avatar_person_collisions > 0; }},
+  };
+  return rates;
+}
+
+const std::vector<std::string>& summarized_columns() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const Column& c : session_columns()) {
+      if (c.summarized) out.push_back(c.name);
+    }
+    return out;
+  }();
+  return names;
+}
+
+Statistic statistic_of(std::vector<double> values) {
+  Statistic out;
+  out.n = values.size();
+  if (values.empty()) return out;
+  double sum = 0.0;
+  for (const double v : values) sum += v;
+  out.mean = sum / static_cast<double>(values.size());
+  std::sort(values.begin(), values.end());
+  const std::size_t mid = values.size() / 2;
+  out.median = values.size() % 2 == 1 ? values[mid] : 0.5 * (values[mid - 1] + values[mid]);
+  return out;
+}
+
+std::vector<GroupSummary> summarize(const std::vector<SessionMetrics>& sessions) {
+  std::vector<const SessionMetrics*> everyone;
+  std::map<std::string, std::vector<const SessionMetrics*>> by_scenario;
+  for (const SessionMetrics& m : sessions) {
+    everyone.push_back(&m);
+    by_scenario[m.scenario].push_back(&m);
+  }
+  std::vector<GroupSummary> out;
+  out.push_back(summarize_group(everyone));
+  out.back().all = true;
+  for (const auto& [scenario, group] : by_scenario) {
+    out.push_back(summarize_group(group));
+    out.back().scenario = scenario;
+  }
+  return out;
+}
+
+}  // namespace rfbsim::report

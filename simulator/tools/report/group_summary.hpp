@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// GroupSummary: the overall tables: for all sessions and for each scenario, the SEAN-EP rates (percent of
+// sessions) and the mean and median of every summarized sessions.csv column.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "session_metrics.hpp"
+
+namespace rfbsim::report {
+
+/// A yes/no property of a session, reported as a percentage of a group's sessions.
+struct Rate {
+  std::string name;     ///< summary.csv's column is pct_<name>
+  std::string meaning;  ///< one line for the report
+  std::function<bool(const SessionMetrics&)> holds;
+};
+
+/// The rates, in order: timed_out, completed, never_moved, found_robot, robot_within_0_45,
+/// robot_within_1_2, avatar_pushed_robot, avatar_person_collision.
+const std::vector<Rate>& summary_rates();
+
+/// The mean and median of one column over the sessions of a group that have a value for it.
+struct Statistic {
+  std::size_t n = 0;             ///< sessions with a value
+  std::optional<double> mean;    ///< none when n is 0
+  std::optional<double> median;  ///< the middle value, or the mean of the two middle values
+};
+
+/// One group's line of summary.csv.
+struct GroupSummary {
+  bool all = false;      ///< all sessions; otherwise one scenario's
+  std::string scenario;  ///< the scenario's name ("" for all)
+  std::size_t sessions = 0;
+  std::vector<double> rate_percent;    ///< % of sessions, parallel to summary_rates()
+  std::vector<Statistic> statistics;   ///< parallel to summarized_columns()
+};
+
+/// The names of session_columns() with `summarized` set, in order.
+const std::vector<std::string>& summarized_columns();
+
+/// All sessions first, then each scenario in name order.
+std::vector<GroupSummary> summarize(const std::vector<SessionMetrics>& sessions);
+
+/// The statistic of `values` (any order).
+Statistic statistic_of(std::vector<double> values);
+
+}  // namespace rfbsim::report

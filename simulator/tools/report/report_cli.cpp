@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// sim_report's command line.
+#include "report_cli.hpp"
+
+namespace rfbsim::report {
+
+std::optional<CliOptions> parse_cli(const std::vector<std::string>& args, CliError& error) {
+  CliOptions options;
+  std::vector<std::string> positional;
+  bool out_given = false;
+  bool options_end = false;  // after "--" everything is a path, even "-x"
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (options_end || arg.empty() || arg[0] != '-' || arg == "-") {
+      positional.push_back(arg);
+    } else if (arg == "--") {
+      options_end = true;
+    } else if (arg == "--help" || arg == "-h") {
+      options.help = true;
+      return options;
+    } else if (arg == "--out" || arg.rfind("--out=", 0) == 0) {
+      std::string value;
+      if (arg == "--out") {
+        if (i + 1 >= args.size()) {
+          error.message = "--out needs a folder";
+          return std::nullopt;
+        }
+        value = args[++i];
+      } else {
+        value = arg.substr(6);
+      }
+      if (value.empty()) {
+        error.message = "--out needs a folder";
+        return std::nullopt;
+      }
+      options.out_dir = value;
+      out_given = true;
+    } else {
+      error.message = "unknown option '" + arg + "'";
+      return std::nullopt;
+    }
+  }
+  if (positional.size() != 1 || positional[0].empty()) {
+    error.message = positional.empty() ? "DATA_DIR is missing" : "expected one DATA_DIR";
+    return std::nullopt;
+  }
+  options.data_dir = positional[0];
+  if (!out_given) options.out_dir = options.data_dir / "report";
+  return options;
+}
+
+std::string usage_text() {
+  return "Usage: sim_report DATA_DIR [--out DIR]\n"
+         "\n"
+         "Reads every session folder under DATA_DIR (each folder holding a session.json, e.g.\n"
+         "DATA_DIR/sessions/<id>-<uid>/ as sim_manager lays them out) and writes the study's tables and plots:\n"
+         "  sessions.csv   one row per session (docs/report.md defines every column)\n"
+         "  summary.csv    rates, means and medians for all sessions and per scenario\n"
+         "  report.md      the tables in Markdown\n"
+         "  report.html    the tables, Hall-zone histograms and a trajectory plot per session (self-contained)\n"
+         "\n"
+         "Options:\n"
+         "  --out DIR   where to write them (default DATA_DIR/report; created if needed)\n"
+         "  -h, --help  this text\n"
+         "\n"
+         "A session that cannot be read is skipped and named on stderr with the reason; the others are reported.\n"
+         "Exit status: 0 all reported, 1 data errors (sessions skipped, none found, or output not written),\n"
+         "2 usage errors.\n";
+}
+
+}  // namespace rfbsim::report

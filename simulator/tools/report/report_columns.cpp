@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The columns of sessions.csv.
+#include "report_columns.hpp"
+
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+
+#include "text_format.hpp"
+
+namespace rfbsim::report {
+
+namespace {
+
+using M = SessionMetrics;
+
+Value count(std::size_t n) { return static_cast<std::int64_t>(n); }
+Value count(int n) { return static_cast<std::int64_t>(n); }
+Value maybe(const std::optional<double>& v) { return v ? Value(*v) : Value(); }
+
+// A robot measure: empty without robot metrics.
+template <typename Get>
+std::function<Value(const M&)> robot(Get get) {
+  return [get](const M& m) -> Value {
+    if (!m.robot) return {};
+    const auto v = get(*m.robot);
+    if constexpr (std::is_same_v<decltype(v), const std::optional<double>>) {
+      return maybe(v);
+    } else if constexpr (std::is_same_v<decltype(v), const int>) {
+      return count(v);
+    } else {
+      return Value(static_cast<double>(v));
+    }
+  };
+}
+
+Column column(const char* name, const char* unit, const char* meaning, std::function<Value(const M&)> value,
+              bool summarized = false, bool shown = false) {
+  return Column{name, unit, meaning, std::move(value), summarized, shown};
+}
+
+std::vector<Column> make_columns() {
+  // name, unit, meaning, value, summarized, shown
+  return {
+      column("folder", "", "session folder, relative to the data folder",
+             [](const M& m) { return Value(m.folder); }, false, true),
+      column("uid", "", "participant id from the link", [](const M& m) { return Value(m.uid); }, false, true),
+      column("scenario", "", "scenario name", [](const M& m) { return Value(m.scenario); }, false, true),
+      column("scenario_file", "", "scenario file the session was run from",
+             [](const M& m) { return Value(m.scenario_file); }),
+      column("seed", "", "master seed", [](const M& m) { return Value(m.seed); }),
+      column("outcome", "", "completed, timeout, or empty", [](const M& m) { return Value(m.outcome); }, false, true),
+      column("end_reason", "", "why it stopped; empty if it did not end cleanly",
+             [](const M& m) { return Value(m.end_reason); }),
+      column("ended_cleanly", "", "session.json has ended_at", [](const M& m) { return Value(m.ended_cleanly); }),
+      column("duration", "s", "end_tick / tick_hz, else the last sample's time",
+             [](const M& m) { return Value(m.duration); }, true, true),
+      column("samples", "", "whole trajectory samples used", [](const M& m) { return count(m.samples); }),
+      column("partial_samples", "", "sample ticks left out: an agent's row missing or repeated",
+             [](const M& m) { return count(m.partial_samples); }),
+      column("torn_lines", "", "unfinished last lines dropped", [](const M& m) { return count(m.torn_lines); }),
+      column("timed_out", "", "outcome is timeout", [](const M& m) { return Value(m.timed_out); }),
+      column("completed", "", "outcome is completed", [](const M& m) { return Value(m.completed); }),
+      column("avatar_path_length", "m", "distance the avatar walked",
+             [](const M& m) { return Value(m.avatar_path_length); }, true),
+      column("never_moved", "", "avatar path length < 0.1 m",
+             [](const M& m) { return Value(m.never_moved); }, false, true),
+      column("found_robot", "", "the find_robot task step was done",
+             [](const M& m) { return Value(m.found_robot); }, false, true),
+      column("has_robot", "", "the session has a robot", [](const M& m) { return Value(m.has_robot); }),
+      column("min_robot_avatar_distance", "m", "closest robot-avatar centre distance",
+             [](const M& m) { return maybe(m.min_robot_avatar_distance); }, true, true),
+      column("robot_within_0_45", "", "robot ever < 0.45 m from the avatar (centres)",
+             [](const M& m) { return Value(m.robot_within_0_45); }, false, true),
+      column("robot_within_1_2", "", "robot ever < 1.2 m from the avatar (centres)",
+             [](const M& m) { return Value(m.robot_within_1_2); }, false, true),
+      column("avatar_pushed_robot", "", "any avatar-robot contact event",
+             [](const M& m) { return Value(m.avatar_pushed_robot); }),
+      column("avatar_robot_contacts", "", "avatar-robot contact events",
+             [](const M& m) { return count(m.avatar_robot_contacts); }, true, true),
+      column("avatar_person_collisions", "", "avatar-person contact events",
+             [](const M& m) { return count(m.avatar_person_collisions); }, true, true),
+      column("robot_path_length", "m", "distance the robot travelled",
+             robot([](const RobotMetrics& r) { return r.path_length; }), true, true),
+      column("robot_path_ratio", "", "path length / straight start-end distance",
+             robot([](const RobotMetrics& r) { return r.path_ratio; }), true),
+      column("robot_heading_change", "rad", "sum of |heading change|",
+             robot([](const RobotMetrics& r) { return r.heading_change; }), true),
+      column("robot_min_person_distance", "m", "closest person or avatar (centres)",
+             robot([](const RobotMetrics& r) { return r.min_person_distance; }), true, true),
+      column("robot_mean_closest_distance", "m", "closest person's distance, mean over samples",
+             robot([](const RobotMetrics& r) { return r.mean_closest_distance; }), true),
+      column("robot_min_distance_approaching", "m", "closest person while the robot closed in faster",
+             robot([](const RobotMetrics& r) { return r.min_distance_robot_approaching; }), true),
+      column("robot_pct_intimate", "%", "samples with the closest person < 0.45 m",
+             robot([](const RobotMetrics& r) { return r.pct_intimate; }), true),
+      column("robot_pct_personal", "%", "samples with the closest person 0.45-1.2 m",
+             robot([](const RobotMetrics& r) { return r.pct_personal; }), true),
+      column("robot_pct_social", "%", "samples with the closest person 1.2-3.6 m",
+             robot([](const RobotMetrics& r) { return r.pct_social; }), true),
+      column("robot_pct_public", "%", "samples with the closest person >= 3.6 m",
+             robot([](const RobotMetrics& r) { return r.pct_public; }), true),
+      column("robot_collisions_robot_on_person", "", "collisions the robot closed faster",
+             robot([](const RobotMetrics& r) { return r.robot_on_person; }), true, true),
+      column("robot_collisions_person_on_robot", "", "collisions the person closed faster",
+             robot([](const RobotMetrics& r) { return r.person_on_robot; }), true, true),
+      column("robot_time_not_moving", "s", "time with robot speed < 0.01 m/s",
+             robot([](const RobotMetrics& r) { return r.time_not_moving; }), true),
+      column("robot_mean_speed", "m/s", "mean robot speed",
+             robot([](const RobotMetrics& r) { return r.mean_speed; }), true),
+      column("robot_mean_abs_acceleration", "m/s²", "mean |acceleration|",
+             robot([](const RobotMetrics& r) { return r.mean_abs_acceleration; }), true),
+      column("robot_mean_abs_jerk", "m/s³", "mean |jerk|",
+             robot([](const RobotMetrics& r) { return r.mean_abs_jerk; }), true),
+      column("robot_time_to_goal", "s", "time of the robot's first arrival",
+             [](const M& m) { return maybe(m.time_to_goal); }, true, true),
+  };
+}
+
+}  // namespace
+
+const std::vector<Column>& session_columns() {
+  static const std::vector<Column> columns = make_columns();
+  return columns;
+}
+
+const Column& session_column(const std::string& name) {
+  for (const Column& c : session_columns()) {
+    if (c.name == name) return c;
+  }
+  throw std::out_of_range("no sessions.csv column '" + name + "'");
+}
+
+std::string csv_cell(const Value& value) {
+  if (const auto* text = std::get_if<std::string>(&value)) return csv_field(*text);
+  if (const auto* number = std::get_if<double>(&value)) return format_number(*number, 6);
+  if (const auto* n = std::get_if<std::int64_t>(&value)) return std::to_string(*n);
+  if (const auto* flag = std::get_if<bool>(&value)) return *flag ? "1" : "0";
+  return "";
+}
+
+std::string display_cell(const Value& value) {
+  if (const auto* text = std::get_if<std::string>(&value)) return *text;
+  if (const auto* number = std::get_if<double>(&value)) return format_fixed(*number, 3);
+  if (const auto* n = std::get_if<std::int64_t>(&value)) return std::to_string(*n);
+  if (const auto* flag = std::get_if<bool>(&value)) return *flag ? "yes" : "no";
+  return "";
+}
+
+std::optional<double> numeric_value(const Value& value) {
+  if (const auto* number = std::get_if<double>(&value)) return *number;
+  if (const auto* n = std::get_if<std::int64_t>(&value)) return static_cast<double>(*n);
+  if (const auto* flag = std::get_if<bool>(&value)) return *flag ? 1.0 : 0.0;
+  return std::nullopt;
+}
+
+}  // namespace rfbsim::report

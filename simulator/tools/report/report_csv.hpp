@@ -1,0 +1,23 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// sessions.csv and summary.csv as text (docs/report.md defines every column).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "group_summary.hpp"
+#include "session_metrics.hpp"
+
+namespace rfbsim::report {
+
+/// A header line of session_columns()' names, then one line per session.
+std::string sessions_csv(const std::vector<SessionMetrics>& sessions);
+
+/// summary.csv's column names: scope, scenario, sessions, pct_<rate> per rate, then <column>_n,
+/// <column>_mean and <column>_median per summarized column.
+std::vector<std::string> summary_csv_header();
+
+/// A header line, then one line per group (scope "all" first, then "scenario" lines).
+std::string summary_csv(const std::vector<GroupSummary>& groups);
+
+}  // namespace rfbsim::report

@@ -1,0 +1,152 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The report job: read, measure, plot, render, write.
+#include "report_job.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <optional>
+
+#include "record/digest.hpp"
+#include "record/session_log.hpp"
+#include "report_csv.hpp"
+#include "report_html.hpp"
+#include "report_markdown.hpp"
+#include "scenario/scenario.hpp"
+#include "session_samples.hpp"
+#include "trajectory_plot.hpp"
+
+namespace rfbsim::report {
+
+namespace {
+
+// The map of one scenario file, loaded once for all its sessions.
+struct LoadedMap {
+  std::optional<MapDrawing> drawing;  // none when the file could not be loaded
+  std::string problem;                // why not
+  std::string sha256;                 // of the file as it is now ("" if unreadable)
+};
+
+class MapCache {
+ public:
+  const LoadedMap& get(const std::string& scenario_file) {
+    auto it = maps_.find(scenario_file);
+    if (it != maps_.end()) return it->second;
+    LoadedMap map;
+    if (scenario_file.empty()) {
+      map.problem = "the session ran in the built-in test room (no scenario file)";
+    } else {
+      try {
+        const sim::Scenario scenario = sim::load_scenario(scenario_file);
+        map.drawing = draw_map(scenario.map, scenario.props, "map-" + std::to_string(definitions_.size()));
+        definitions_.push_back(map.drawing->definition);
+        map.sha256 = sim::sha256_file(scenario_file);
+      } catch (const std::exception& e) {
+        map.problem = e.what();
+      }
+    }
+    return maps_.emplace(scenario_file, std::move(map)).first->second;
+  }
+  std::vector<std::string> take_definitions() { return std::move(definitions_); }
+
+ private:
+  std::map<std::string, LoadedMap> maps_;
+  std::vector<std::string> definitions_;
+};
+
+std::string caption(const sim::SessionLog& log, const SampledSession& samples, const LoadedMap& map) {
+  std::string out = std::to_string(samples.samples.size()) + " samples at " + std::to_string(log.meta.trajectory_hz) +
+                    " Hz";
+  if (samples.partial_samples > 0) out += " (" + std::to_string(samples.partial_samples) + " partial left out)";
+  out += ". ";
+  if (!map.drawing) {
+    out += "Drawn without walls: the scenario file could not be loaded (" + map.problem + ").";
+  } else {
+    out += "Walls and props from " + log.meta.scenario_file + ".";
+    if (!log.meta.scenario_sha256.empty() && map.sha256 != log.meta.scenario_sha256) {
+      out += " That file has changed since this session ran (its SHA-256 differs from session.json's): the "
+             "walls may not be the ones the participant saw.";
+    }
+  }
+  return out;
+}
+
+std::string folder_name(const std::filesystem::path& dir, const std::filesystem::path& data_dir) {
+  const std::filesystem::path relative = dir.lexically_relative(data_dir);
+  return relative.empty() ? dir.string() : relative.string();
+}
+
+// Writes a whole file through a temporary and a rename, so that a reader never sees half a report.
+void write_file(const std::filesystem::path& path, const std::string& text, JobResult& result) {
+  const std::filesystem::path temporary = path.string() + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.close();
+    if (!out) {
+      result.write_errors.push_back(path.string() + ": cannot write");
+      return;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    result.write_errors.push_back(path.string() + ": cannot write (" + ec.message() + ")");
+    return;
+  }
+  result.written.push_back(path);
+}
+
+}  // namespace
+
+int JobResult::exit_status() const {
+  return sessions_found > 0 && skipped.empty() && write_errors.empty() ? 0 : 1;
+}
+
+JobResult run_report(const std::filesystem::path& data_dir, const std::filesystem::path& out_dir,
+                     const ProgressFn& progress) {
+  JobResult result;
+  ReportData data;
+  data.data_dir = data_dir.string();
+  MapCache maps;
+
+  // Each session on its own: whatever goes wrong with one is its reason for being skipped.
+  const std::vector<std::filesystem::path> dirs = sim::find_session_dirs(data_dir);
+  result.sessions_found = dirs.size();
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    const std::string folder = folder_name(dirs[i], data_dir);
+    try {
+      const sim::SessionLog log = sim::read_session(dirs[i]);
+      const SampledSession samples = assemble_samples(log);
+      SessionMetrics metrics = session_metrics(log, samples);
+      metrics.folder = folder;
+      const LoadedMap& map = maps.get(log.meta.scenario_file);
+      SessionPlot plot{trajectory_svg(samples, map.drawing ? &*map.drawing : nullptr), caption(log, samples, map)};
+      data.sessions.push_back(std::move(metrics));
+      data.plots.push_back(std::move(plot));
+    } catch (const sim::SessionLogError& e) {
+      data.skipped.push_back({folder, e.what()});
+    } catch (const std::exception& e) {
+      data.skipped.push_back({folder, std::string("cannot be reported: ") + e.what()});
+    }
+    if (progress) progress(i + 1, dirs.size());
+  }
+  result.sessions_reported = data.sessions.size();
+  result.skipped = data.skipped;
+  data.groups = summarize(data.sessions);
+  data.map_definitions = maps.take_definitions();
+
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) {
+    result.write_errors.push_back(out_dir.string() + ": cannot create the folder (" + ec.message() + ")");
+    return result;
+  }
+  write_file(out_dir / "sessions.csv", sessions_csv(data.sessions), result);
+  write_file(out_dir / "summary.csv", summary_csv(data.groups), result);
+  write_file(out_dir / "report.md", markdown_report(data), result);
+  write_file(out_dir / "report.html", html_report(data), result);
+  return result;
+}
+
+}  // namespace rfbsim::report

@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The report job: every session folder under a data folder read, measured and plotted, and the four
+// report files written. A session that cannot be read is skipped with its reason; it never stops the rest.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "report_data.hpp"
+
+namespace rfbsim::report {
+
+/// What a report run did.
+struct JobResult {
+  std::size_t sessions_found = 0;       ///< folders with a session.json
+  std::size_t sessions_reported = 0;
+  std::vector<SkippedSession> skipped;  ///< in folder order
+  std::vector<std::string> write_errors;  ///< output files that could not be written, with why
+  std::vector<std::filesystem::path> written;  ///< output files written
+
+  /// sim_report's exit status: 0 when every session was reported (at least one), else 1.
+  [[nodiscard]] int exit_status() const;
+};
+
+/// Called after each session with how many are done of how many.
+using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
+
+/// Reads every session under `data_dir` (find_session_dirs) and writes sessions.csv, summary.csv,
+/// report.md and report.html into `out_dir`, creating it. `progress` may be empty.
+JobResult run_report(const std::filesystem::path& data_dir, const std::filesystem::path& out_dir,
+                     const ProgressFn& progress = {});
+
+}  // namespace rfbsim::report

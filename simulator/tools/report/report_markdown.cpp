@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// report.md.
+#include "report_markdown.hpp"
+
+#include "report_columns.hpp"
+#include "text_format.hpp"
+
+namespace rfbsim::report {
+
+namespace {
+
+using Row = std::vector<std::string>;
+
+// A table. Cells arrive escaped: strings from the data through markdown_escape; column names, units and
+// numbers are ours and hold no markup.
+void table(std::string& out, const Row& header, const std::vector<Row>& rows) {
+  const auto line = [&](const Row& cells) {
+    out += "|";
+    for (const std::string& c : cells) out += " " + c + " |";
+    out += "\n";
+  };
+  line(header);
+  out += "|";
+  for (std::size_t i = 0; i < header.size(); ++i) out += i == 0 ? " --- |" : " ---: |";
+  out += "\n";
+  for (const Row& r : rows) line(r);
+  out += "\n";
+}
+
+std::string group_name(const GroupSummary& g) {
+  return g.all ? "all sessions" : "scenario " + markdown_escape(g.scenario.empty() ? "(unnamed)" : g.scenario);
+}
+
+std::string optional_cell(const std::optional<double>& v) { return v ? format_fixed(*v, 3) : ""; }
+
+std::string with_unit(const Column& c) { return c.unit.empty() ? c.name : c.name + " (" + c.unit + ")"; }
+
+}  // namespace
+
+std::string markdown_report(const ReportData& data) {
+  std::string out = "# rfbsim session report\n\n";
+  out += "Data folder: " + markdown_escape(data.data_dir) + "  \n";
+  out += std::to_string(data.sessions.size()) + " sessions reported, " + std::to_string(data.skipped.size()) +
+         " skipped. Definitions of every measure: docs/report.md.\n\n";
+
+  // The SEAN-EP rates per group.
+  out += "## Overview (% of sessions)\n\n";
+  Row header = {"group", "N"};
+  for (const Rate& r : summary_rates()) header.push_back("% " + r.meaning);
+  std::vector<Row> rows;
+  for (const GroupSummary& g : data.groups) {
+    Row row = {group_name(g), std::to_string(g.sessions)};
+    for (const double pct : g.rate_percent) row.push_back(format_fixed(pct, 1));
+    rows.push_back(row);
+  }
+  table(out, header, rows);
+
+  // Mean and median of each measure, one table per group.
+  out += "## Measures (mean and median over the sessions that have a value)\n\n";
+  for (const GroupSummary& g : data.groups) {
+    out += "### " + group_name(g) + "\n\n";
+    rows.clear();
+    for (std::size_t i = 0; i < summarized_columns().size(); ++i) {
+      const Column& c = session_column(summarized_columns()[i]);
+      const Statistic& s = g.statistics[i];
+      rows.push_back({c.name, c.unit, std::to_string(s.n), optional_cell(s.mean), optional_cell(s.median)});
+    }
+    table(out, {"measure", "unit", "N", "mean", "median"}, rows);
+  }
+
+  out += "## Sessions\n\n";
+  header.clear();
+  for (const Column& c : session_columns()) {
+    if (c.shown) header.push_back(with_unit(c));
+  }
+  rows.clear();
+  for (const SessionMetrics& m : data.sessions) {
+    Row row;
+    for (const Column& c : session_columns()) {
+      if (!c.shown) continue;
+      // Text comes from the data and is escaped; numbers and flags are ours.
+      const Value value = c.value(m);
+      const bool text = std::holds_alternative<std::string>(value);
+      row.push_back(text ? markdown_escape(display_cell(value)) : display_cell(value));
+    }
+    rows.push_back(row);
+  }
+  table(out, header, rows);
+  out += "Every column, unrounded: sessions.csv.\n\n";
+
+  if (!data.skipped.empty()) {
+    out += "## Skipped sessions\n\n";
+    rows.clear();
+    for (const SkippedSession& s : data.skipped) rows.push_back({markdown_escape(s.folder), markdown_escape(s.reason)});
+    table(out, {"folder", "reason"}, rows);
+  }
+  return out;
+}
+
+}  // namespace rfbsim::report

@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// SessionMetrics: session.json's facts, the events' counts and the samples' distances.
+#include "session_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rfbsim::report {
+
+namespace {
+
+bool is_pair(const sim::Event& contact, const char* one, const char* other) {
+  const std::string& a = contact.text("a");
+  const std::string& b = contact.text("b");
+  return (a == one && b == other) || (a == other && b == one);
+}
+
+// What the events say: contacts, the find_robot step, the robot's arrival.
+void count_events(const sim::SessionLog& log, SessionMetrics& out) {
+  for (const sim::Event& event : log.events) {
+    if (event.type == "contact") {
+      if (is_pair(event, "avatar", "robot")) ++out.avatar_robot_contacts;
+      if (is_pair(event, "avatar", "person")) ++out.avatar_person_collisions;
+    } else if (event.type == "task") {
+      if (event.text("event") == "done" && event.text("task") == "find_robot") out.found_robot = true;
+    } else if (event.type == "robot") {
+      if (event.text("state") == "arrived" && !out.time_to_goal) out.time_to_goal = event.time;
+    }
+  }
+  out.avatar_pushed_robot = out.avatar_robot_contacts > 0;
+}
+
+// The avatar's walk and its closest approach to the robot, over the samples.
+void measure_avatar(const SampledSession& samples, SessionMetrics& out) {
+  double closest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < samples.samples.size(); ++i) {
+    const Sample& s = samples.samples[i];
+    if (i > 0) {
+      const AgentState& before = samples.samples[i - 1].avatar;
+      out.avatar_path_length += std::hypot(s.avatar.x - before.x, s.avatar.y - before.y);
+    }
+    if (s.robot) closest = std::min(closest, std::hypot(s.robot->x - s.avatar.x, s.robot->y - s.avatar.y));
+  }
+  out.never_moved = out.avatar_path_length < kNeverMovedPath;
+  if (std::isfinite(closest)) {
+    out.min_robot_avatar_distance = closest;
+    out.robot_within_0_45 = closest < kSeanIntimate;
+    out.robot_within_1_2 = closest < kSeanPersonal;
+  }
+}
+
+}  // namespace
+
+SessionMetrics session_metrics(const sim::SessionLog& log, const SampledSession& samples) {
+  const sim::SessionMeta& meta = log.meta;
+  SessionMetrics out;
+  out.uid = meta.uid;
+  out.scenario = meta.scenario;
+  out.scenario_file = meta.scenario_file;
+  out.seed = std::to_string(meta.seed);
+  out.outcome = meta.outcome.value_or("");
+  out.end_reason = meta.end_reason.value_or("");
+  out.ended_cleanly = meta.ended_at.has_value();
+  if (meta.end_tick) {
+    out.duration = static_cast<double>(*meta.end_tick) / meta.tick_hz;
+  } else if (!log.trajectory.empty()) {
+    out.duration = log.trajectory.back().time;
+  }
+  out.samples = samples.samples.size();
+  out.partial_samples = samples.partial_samples;
+  out.torn_lines = log.torn_lines;
+
+  out.timed_out = out.outcome == "timeout";
+  out.completed = out.outcome == "completed";
+  out.has_robot = samples.has_robot;
+  count_events(log, out);
+  measure_avatar(samples, out);
+  out.robot = robot_metrics(samples);
+  return out;
+}
+
+}  // namespace rfbsim::report

@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// SessionMetrics: everything sim_report says about one session: who and what, the SEAN-EP study's
+// measures of the participant and the robot (REFERENCE.md), and the robot's social-navigation measures.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+
+#include "record/session_log.hpp"
+#include "robot_metrics.hpp"
+#include "session_samples.hpp"
+
+namespace rfbsim::report {
+
+/// Distances the SEAN-EP paper counted the robot as "within" the avatar at (centre to centre).
+constexpr double kSeanIntimate = 0.45;  // m
+constexpr double kSeanPersonal = 1.2;   // m
+/// An avatar that walked less than this over the whole session never moved.
+constexpr double kNeverMovedPath = 0.1;  // m
+
+/// One session's row of the report.
+struct SessionMetrics {
+  // Who and what.
+  std::string folder;  ///< the session folder relative to the data folder (set by the caller)
+  std::string uid, scenario, scenario_file, seed;
+  std::string outcome;     ///< completed, timeout or "" (none)
+  std::string end_reason;  ///< completed, timeout, signal, error or "" (did not end cleanly)
+  bool ended_cleanly = false;  ///< session.json has ended_at
+  double duration = 0.0;       ///< s: end_tick / tick_hz, else the last sample's time
+  std::size_t samples = 0;          ///< whole trajectory samples used
+  std::size_t partial_samples = 0;  ///< sample ticks left out (someone's row missing or repeated)
+  std::size_t torn_lines = 0;       ///< unfinished last lines dropped
+
+  // The SEAN-EP study's measures.
+  bool timed_out = false;    ///< outcome is timeout
+  bool completed = false;    ///< outcome is completed
+  double avatar_path_length = 0.0;  ///< m
+  bool never_moved = false;  ///< avatar_path_length < 0.1 m
+  bool found_robot = false;  ///< a task event: event done, task find_robot
+  bool has_robot = false;    ///< session.json lists a robot
+  std::optional<double> min_robot_avatar_distance;  ///< m, centres; none without robot samples
+  bool robot_within_0_45 = false;  ///< min_robot_avatar_distance < 0.45 m
+  bool robot_within_1_2 = false;   ///< min_robot_avatar_distance < 1.2 m
+  int avatar_robot_contacts = 0;     ///< contact events between the avatar and the robot
+  bool avatar_pushed_robot = false;  ///< avatar_robot_contacts > 0
+  int avatar_person_collisions = 0;  ///< contact events between the avatar and a person
+
+  // The robot's social-navigation measures; none without a robot or samples.
+  std::optional<RobotMetrics> robot;
+  std::optional<double> time_to_goal;  ///< s: the first robot event with state arrived
+};
+
+/// Computes a session's metrics from its log and its samples (assemble_samples(log)).
+SessionMetrics session_metrics(const sim::SessionLog& log, const SampledSession& samples);
+
+}  // namespace rfbsim::report

@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Real sim_rfb processes recording a session: killed with SIGKILL they leave readable files up to their last
+// second; ended with SIGTERM they close session.json with the end; a viewer's connect is recorded hashed.
+#include <catch2/catch.hpp>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "http_client.hpp"
+#include "rfb_test_client.hpp"
+#include "sim_process.hpp"
+
+using nlohmann::json;
+using rfbsim::test::SimProcess;
+
+namespace {
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("rfbsim_recording_" + std::to_string(::getpid())) / name;
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+// Complete lines only: a last line without its newline is a write the kill cut short.
+std::vector<std::string> complete_lines(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream whole;
+  whole << in.rdbuf();
+  const std::string text = whole.str();
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  for (std::size_t end = text.find('\n'); end != std::string::npos; end = text.find('\n', start)) {
+    lines.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return lines;
+}
+
+// The simulation's tick now, from /status.json.
+std::uint64_t current_tick(int port) {
+  const auto response = rfbsim::test::net::http_get(port, "/status.json");
+  REQUIRE(response.status == 200);
+  return json::parse(response.body)["tick"].get<std::uint64_t>();
+}
+
+}  // namespace
+
+TEST_CASE("sim_rfb killed with SIGKILL leaves readable session files up to its last second") {
+  const auto dir = fresh_dir("killed");
+  SimProcess sim(rfbsim::test::sim_rfb_path(),
+                 {"--port", "0", "--scenario", "lab", "--data-dir", dir.string(), "--uid", "p-killed"});
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  const std::uint64_t tick_before_kill = current_tick(sim.port());
+  REQUIRE(tick_before_kill > 60);
+  ::kill(sim.pid(), SIGKILL);
+  sim.stop(SIGKILL);
+
+  const json session = json::parse(std::ifstream(dir / "session.json"));
+  CHECK(session["uid"] == "p-killed");
+  CHECK(session["ended_at"].is_null());  // it never ended cleanly, and says so
+  const auto rows = complete_lines(dir / "trajectories.csv");
+  REQUIRE(rows.size() > 1);
+  CHECK(rows.front() == "tick,time,kind,id,x,y,yaw,vx,vy");
+  std::uint64_t last_tick = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    std::stringstream row(rows[i]);
+    std::string field;
+    std::vector<std::string> fields;
+    while (std::getline(row, field, ',')) fields.push_back(field);
+    REQUIRE(fields.size() == 9);
+    last_tick = std::stoull(fields[0]);
+    CHECK(std::isfinite(std::stod(fields[4])));
+  }
+  // Rows reach the file at least twice a second, so at most one second (60 ticks) before the kill is lost.
+  CHECK(last_tick + 60 >= tick_before_kill);
+  for (const std::string& line : complete_lines(dir / "events.jsonl")) CHECK_NOTHROW(json::parse(line));
+}
+
+TEST_CASE("sim_rfb ended with SIGTERM writes the end, and records a viewer with its address hashed") {
+  const auto dir = fresh_dir("terminated");
+  SimProcess sim(rfbsim::test::sim_rfb_path(), {"--port", "0", "--scenario", "lab", "--data-dir", dir.string()});
+  {
+    rfbsim::test::RfbTestClient client("127.0.0.1", sim.port());
+    REQUIRE(client.wait_for_updates(1, std::chrono::seconds(20)));
+    client.send_key('w', true);
+    client.pump_until([] { return false; }, std::chrono::milliseconds(300));
+    client.send_key('w', false);
+    client.pump_until([] { return false; }, std::chrono::milliseconds(300));
+  }
+  const int status = sim.stop(SIGTERM);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  const json session = json::parse(std::ifstream(dir / "session.json"));
+  CHECK(session["end_reason"] == "signal");
+  CHECK(session["ended_at"].is_string());
+  CHECK(session["outcome"].is_null());
+  bool connect_seen = false, timer_seen = false, w_down = false;
+  for (const std::string& line : complete_lines(dir / "events.jsonl")) {
+    const json event = json::parse(line);
+    if (event["type"] == "client" && event["event"] == "connect") {
+      connect_seen = true;
+      CHECK(event["address"].get<std::string>().size() == 16);
+      CHECK(event["address"].get<std::string>().find("127") == std::string::npos);
+    }
+    timer_seen = timer_seen || event["type"] == "timer";
+    w_down = w_down || (event["type"] == "key" && event["keysym"] == 'w' && event["down"] == true);
+  }
+  CHECK(connect_seen);
+  CHECK(timer_seen);
+  CHECK(w_down);
+  const auto lines = complete_lines(dir / "events.jsonl");
+  CHECK(json::parse(lines.back())["reason"] == "signal");
+}

@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The real sim_report binary on a generated data folder: its exit status, the files it writes, sessions.csv
+// parsing to the right rows, and the usage errors.
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <string>
+
+#include "session_files.hpp"
+
+using namespace rfbsim::report::test;
+
+namespace {
+
+// Runs sim_report with `args` (already quoted), stdout and stderr to files in `scratch`; its exit status.
+int sim_report(const ScratchDir& scratch, const std::string& args) {
+  const std::string command = std::string("'") + SIM_REPORT_BINARY + "' " + args + " >'" +
+                              (scratch.path() / "stdout.txt").string() + "' 2>'" +
+                              (scratch.path() / "stderr.txt").string() + "'";
+  const int status = std::system(command.c_str());
+  REQUIRE(WIFEXITED(status));
+  return WEXITSTATUS(status);
+}
+
+std::string quoted(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
+
+}  // namespace
+
+TEST_CASE("sim_report writes the four files for a data folder and sessions.csv has a row per session") {
+  ScratchDir scratch;
+  const auto data = scratch.path() / "data";
+  for (const char* uid : {"p001", "p002", "p003"}) {
+    SessionSpec spec = small_session();
+    spec.uid = uid;
+    write_session(data / "sessions" / (std::string("1-") + uid), spec);
+  }
+
+  CHECK(sim_report(scratch, quoted(data)) == 0);
+  for (const char* name : {"sessions.csv", "summary.csv", "report.md", "report.html"}) {
+    INFO(name);
+    CHECK(std::filesystem::is_regular_file(data / "report" / name));
+  }
+  const auto rows = csv_records(read_text(data / "report" / "sessions.csv"));
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[0].at("uid") == "p001");
+  CHECK(rows[2].at("uid") == "p003");
+  CHECK(rows[1].at("robot_path_length") == "0");
+  CHECK_THAT(read_text(scratch.path() / "stdout.txt"), Catch::Contains("report.html"));
+  CHECK_THAT(read_text(scratch.path() / "stderr.txt"), Catch::Contains("3 sessions reported, 0 skipped"));
+}
+
+TEST_CASE("sim_report exits 1 and names a skipped session, writing the report of the others") {
+  ScratchDir scratch;
+  const auto data = scratch.path() / "data";
+  write_session(data / "1-good", small_session());
+  write_session(data / "2-bad", small_session());
+  std::filesystem::remove(data / "2-bad" / "events.jsonl");
+
+  CHECK(sim_report(scratch, quoted(data) + " --out " + quoted(scratch.path() / "out")) == 1);
+  CHECK_THAT(read_text(scratch.path() / "stderr.txt"),
+             Catch::Contains("skipped 2-bad: ") && Catch::Contains("events.jsonl: missing"));
+  CHECK(csv_records(read_text(scratch.path() / "out" / "sessions.csv")).size() == 1);
+}
+
+TEST_CASE("sim_report exits 2 on usage errors and 0 for help") {
+  ScratchDir scratch;
+  CHECK(sim_report(scratch, "") == 2);
+  CHECK_THAT(read_text(scratch.path() / "stderr.txt"), Catch::Contains("DATA_DIR is missing"));
+  CHECK(sim_report(scratch, "--frobnicate " + quoted(scratch.path())) == 2);
+  CHECK(sim_report(scratch, quoted(scratch.path() / "no-such-folder")) == 2);
+  CHECK(sim_report(scratch, "--help") == 0);
+  CHECK_THAT(read_text(scratch.path() / "stdout.txt"), Catch::Contains("Usage: sim_report DATA_DIR"));
+}

@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// PROXY protocol version 1 headers: what a relay in front of librfbsim sends, and what is refused.
+#include <catch2/catch.hpp>
+
+#include "proxy_header.hpp"
+
+using rfbsim::detail::parse_proxy_header;
+using Status = rfbsim::detail::ProxyHeader::Status;
+
+TEST_CASE("a TCP4 header gives the source address and its length, the client's bytes follow") {
+  const std::string line = "PROXY TCP4 203.0.113.5 127.0.0.1 51234 40000\r\n";
+  const auto header = parse_proxy_header(line + "RFB 003.008\n");
+  CHECK(header.status == Status::Valid);
+  CHECK(header.length == line.size());
+  CHECK(header.source == "203.0.113.5");
+}
+
+TEST_CASE("TCP6 and UNKNOWN headers are valid too") {
+  const auto six = parse_proxy_header("PROXY TCP6 2001:db8::1 ::1 443 40000\r\n");
+  CHECK(six.status == Status::Valid);
+  CHECK(six.source == "2001:db8::1");
+  const auto unknown = parse_proxy_header("PROXY UNKNOWN\r\n");
+  CHECK(unknown.status == Status::Valid);
+  CHECK(unknown.source.empty());
+  CHECK(unknown.length == 15);
+}
+
+TEST_CASE("a header still arriving waits, at most 107 bytes") {
+  CHECK(parse_proxy_header("").status == Status::Incomplete);
+  CHECK(parse_proxy_header("PRO").status == Status::Incomplete);
+  CHECK(parse_proxy_header("PROXY TCP4 203.0.113.5 127.0.0.1 5").status == Status::Incomplete);
+  CHECK(parse_proxy_header("PROXY " + std::string(101, 'x')).status == Status::Invalid);
+}
+
+TEST_CASE("anything else is refused: other protocols, bad addresses, ports and fields") {
+  CHECK(parse_proxy_header("RFB 003.008\n").status == Status::Invalid);
+  CHECK(parse_proxy_header("GET / HTTP/1.1\r\n").status == Status::Invalid);
+  CHECK(parse_proxy_header("PROXY TCP4 203.0.113 127.0.0.1 1 2\r\n").status == Status::Invalid);
+  CHECK(parse_proxy_header("PROXY TCP4 2001:db8::1 127.0.0.1 1 2\r\n").status == Status::Invalid);
+  CHECK(parse_proxy_header("PROXY TCP4 203.0.113.5 127.0.0.1 65536 2\r\n").status == Status::Invalid);
+  CHECK(parse_proxy_header("PROXY TCP4 203.0.113.5 127.0.0.1 01 2\r\n").status == Status::Invalid);
+  CHECK(parse_proxy_header("PROXY TCP4 203.0.113.5 127.0.0.1 1\r\n").status == Status::Invalid);
+  CHECK(parse_proxy_header("PROXY TCP4  203.0.113.5 127.0.0.1 1 2\r\n").status == Status::Invalid);
+  CHECK(parse_proxy_header("PROXY UDP4 203.0.113.5 127.0.0.1 1 2\r\n").status == Status::Invalid);
+  CHECK(parse_proxy_header(std::string("PROXY TCP4 203.0.113.5\0 127.0.0.1 1 2\r\n", 40)).status == Status::Invalid);
+}
