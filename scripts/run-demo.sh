@@ -7,4 +7,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 # The demo lets a link be opened again after its session ended; a study leaves allow_repeat off.
-exec build/manager/sim_manager --scenarios warehouse,lab --allow-repeat true --data-dir build/demo-data "$@"
+exec build/manager/sim_manager --scenarios warehouse,lab,tutorial --allow-repeat true --data-dir build/demo-data "$@"

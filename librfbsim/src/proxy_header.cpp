@@ -35,6 +35,11 @@ bool is_port(std::string_view text) {
 
 bool is_address(std::string_view text, int family) {
   if (text.empty() || text.size() > 45) return false;
+  // inet_pton reads a C string: a NUL inside would hide what follows it.
+  for (const char c : text) {
+    const bool ok = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F') || c == '.' || c == ':';
+    if (!ok) return false;
+  }
   const std::string copy(text);
   unsigned char bytes[16];
   return ::inet_pton(family, copy.c_str(), bytes) == 1;

@@ -42,5 +42,5 @@ TEST_CASE("anything else is refused: other protocols, bad addresses, ports and f
   CHECK(parse_proxy_header("PROXY TCP4 203.0.113.5 127.0.0.1 1\r\n").status == Status::Invalid);
   CHECK(parse_proxy_header("PROXY TCP4  203.0.113.5 127.0.0.1 1 2\r\n").status == Status::Invalid);
   CHECK(parse_proxy_header("PROXY UDP4 203.0.113.5 127.0.0.1 1 2\r\n").status == Status::Invalid);
-  CHECK(parse_proxy_header(std::string("PROXY TCP4 203.0.113.5\0 127.0.0.1 1 2\r\n", 40)).status == Status::Invalid);
+  CHECK(parse_proxy_header(std::string("PROXY TCP4 203.0.113.5\0 127.0.0.1 1 2\r\n", 39)).status == Status::Invalid);
 }
