@@ -211,9 +211,10 @@ int run(const rfbsim::sim::SimOptions& options) {
     server_options.json_routes["/status.json"] = [&status] { return status.read(); };
   }
   ClientChanges client_changes;
-  server_options.on_connect = [&client_changes](const rfbsim::ClientInfo& c) {
-    std::fprintf(stderr, "[sim_rfb] client %d connected from %s (%s)\n", c.id, c.address.c_str(),
-                 c.websocket ? "websocket" : "rfb");
+  // The log names the participant's address only hashed, as the session data does.
+  server_options.on_connect = [&client_changes, &address_key](const rfbsim::ClientInfo& c) {
+    std::fprintf(stderr, "[sim_rfb] client %d connected, address %s (%s)\n", c.id,
+                 sim::hash_address(address_key, c.address).c_str(), c.websocket ? "websocket" : "rfb");
     client_changes.push(true, c);
   };
   server_options.on_disconnect = [&client_changes](const rfbsim::ClientInfo& c) {
@@ -267,7 +268,8 @@ int run(const rfbsim::sim::SimOptions& options) {
         study.client_connected(change.client.id, sim::hash_address(address_key, change.client.address),
                                change.client.websocket);
       } else {
-        study.client_disconnected(change.client.id);
+        study.client_disconnected(change.client.id, sim::hash_address(address_key, change.client.address),
+                                  change.client.websocket);
       }
     }
     for (const rfbsim::InputEvent& event : server.poll_input()) {

@@ -33,9 +33,10 @@ void StudySession::client_connected(int client, const std::string& address_hash,
   record_task_events();
 }
 
-void StudySession::client_disconnected(int client) {
+void StudySession::client_disconnected(int client, const std::string& address_hash, bool websocket) {
   if (writer_ == nullptr) return;
-  writer_->event(simulation_.world().tick, "client", {{"event", "disconnect"}, {"client", client}});
+  writer_->event(simulation_.world().tick, "client",
+                 {{"event", "disconnect"}, {"client", client}, {"address", address_hash}, {"websocket", websocket}});
 }
 
 void StudySession::step() {

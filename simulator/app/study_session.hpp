@@ -31,7 +31,8 @@ class StudySession {
   void pointer(int x, int y, int buttons, int client);
   /// A viewer arrived: recorded with its hashed address; the first one starts the task's clock.
   void client_connected(int client, const std::string& address_hash, bool websocket);
-  void client_disconnected(int client);
+  /// A viewer left (recorded with the same hashed address as its connect).
+  void client_disconnected(int client, const std::string& address_hash, bool websocket);
 
   /// One tick: simulation, task, then the tick's trajectory sample and events.
   void step();

@@ -88,6 +88,10 @@ SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const 
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw std::runtime_error(dir_.string() + ": cannot create the session folder (" + ec.message() + ")");
+  // Appending a second session to a first one's files would mix them beyond repair.
+  if (std::filesystem::exists(dir_ / "session.json", ec)) {
+    throw std::runtime_error(dir_.string() + ": already holds a session (session.json); record into a new folder");
+  }
   if (info_.trajectory_hz < 1 || info_.tick_hz % info_.trajectory_hz != 0) {
     throw std::runtime_error("trajectory rate " + std::to_string(info_.trajectory_hz) + " Hz must divide the tick rate " +
                              std::to_string(info_.tick_hz) + " Hz");

@@ -44,7 +44,7 @@ struct SessionEnd {
 class SessionWriter {
  public:
   /// Creates `dir` if needed and writes session.json (with `world`'s agents) and the CSV header. Throws
-  /// std::runtime_error naming the path when it cannot.
+  /// std::runtime_error naming the path when it cannot, or when `dir` already holds a session.
   SessionWriter(std::filesystem::path dir, SessionInfo info, const World& world,
                 std::chrono::milliseconds flush_interval = std::chrono::milliseconds(500));
   ~SessionWriter();

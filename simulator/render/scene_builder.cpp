@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "map/grid_map.hpp"
 #include "render/scene_parts.hpp"
@@ -21,6 +22,53 @@ DrawItem box(const Eigen::Vector3f& centre, const Eigen::Vector3f& size, const E
   item.model = Eigen::Translation3f(centre) * Eigen::Scaling(size);
   item.color = color;
   return item;
+}
+
+// The top view's camera: straight down on the centre of the map's bounding box (the map may be turned by
+// its origin yaw), high enough that the floor and the wall tops fit the frame with a small margin. The eye
+// sits a hair south of the target so that look_at's up (world z) stays defined and map +y points up in the
+// picture. Fog is pushed out of reach: from up here every distance is "far".
+void place_top_camera(Scene& scene, const GridMap& map, const SceneStyle& style) {
+  const double map_w = map.width * map.resolution;
+  const double map_h = map.height * map.resolution;
+  Eigen::Vector2d low = map.to_world({0.0, 0.0});
+  Eigen::Vector2d high = low;
+  for (const Eigen::Vector2d& corner : {Eigen::Vector2d(map_w, 0.0), Eigen::Vector2d(0.0, map_h), Eigen::Vector2d(map_w, map_h)}) {
+    const Eigen::Vector2d at = map.to_world(corner);
+    low = low.cwiseMin(at);
+    high = high.cwiseMax(at);
+  }
+  constexpr float kMargin = 1.04f;       // 4 % of room around the map
+  constexpr float kFovDegrees = 40.0f;   // narrow: walls lean out little toward the edges
+  constexpr float kHighestEye = 180.0f;  // m: the renderer's far plane is 200 m
+  const float aspect = style.top_view_aspect > 0.0f ? style.top_view_aspect : 16.0f / 9.0f;
+  const auto half_w = static_cast<float>(high.x() - low.x()) / 2.0f * kMargin;
+  const auto half_h = static_cast<float>(high.y() - low.y()) / 2.0f * kMargin;
+  const float need = std::max(half_h, half_w / aspect);  // half the view's height at the wall tops, m
+  float fov = kFovDegrees;
+  float above_walls = need / std::tan(fov * 0.5f * std::numbers::pi_v<float> / 180.0f);
+  if (above_walls + style.wall_height > kHighestEye) {  // a huge map: widen the lens rather than clip it
+    above_walls = kHighestEye - style.wall_height;
+    fov = std::min(120.0f, 2.0f * std::atan(need / above_walls) * 180.0f / std::numbers::pi_v<float>);
+  }
+  const float eye_height = above_walls + style.wall_height;
+  const Eigen::Vector3f centre{static_cast<float>(low.x() + high.x()) / 2.0f, static_cast<float>(low.y() + high.y()) / 2.0f,
+                               0.0f};
+  scene.camera.eye = centre + Eigen::Vector3f(0.0f, -1e-3f * eye_height, eye_height);
+  scene.camera.target = centre;
+  scene.camera.fov_y_degrees = fov;
+  scene.fog_start = 1e4f;
+  scene.fog_end = 2e4f;
+}
+
+// A translucent ring in the avatar's colour around its feet: from above, a person is a few pixels wide.
+void append_top_view_marker(std::vector<DrawItem>& items, const Eigen::Vector3f& feet, const Eigen::Vector3f& color) {
+  DrawItem ring;
+  ring.shape = Shape::Disc;
+  ring.model = Eigen::Translation3f(feet.x(), feet.y(), 0.012f) * Eigen::Scaling(1.6f, 1.6f, 1.0f);
+  ring.color = color;
+  ring.opacity = 0.55f;
+  items.push_back(ring);
 }
 
 }  // namespace
@@ -70,8 +118,16 @@ Scene build_scene(const World& world, const SceneStyle& style) {
                   rgb(0x2f7fd0));
   append_soft_shadow(scene.items, feet.x(), feet.y(), 0.4f);
 
+  // From above, a ring marks the avatar (the participant view has none).
+  if (style.top_view) append_top_view_marker(scene.items, feet, rgb(0x2f7fd0));
+
   // The navigation overlay last: its translucent squares then blend over the shadows and the floor.
   if (style.debug_overlay && world.robot) append_nav_overlay(scene.items, *world.robot, style.overlay);
+
+  if (style.top_view) {
+    place_top_camera(scene, map, style);
+    return scene;
+  }
 
   // Third-person camera: behind the avatar at the rig's height, looking at its chest a little ahead.
   // It comes closer rather than pass through a wall or a tall shelf behind the avatar.

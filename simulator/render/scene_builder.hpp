@@ -14,12 +14,18 @@ struct SceneStyle {
   float avatar_height = 1.75f;    ///< m, top of the head
   bool debug_overlay = false;     ///< draw the robot's plan, trajectory, goal, estimate and social cost
   NavOverlayStyle overlay;        ///< how that overlay looks
+  /// A bird's-eye camera straight down over the whole map (sim_replay's top view) instead of the
+  /// participant's third-person camera, with a ring under the avatar so that it can be found from above.
+  bool top_view = false;
+  float top_view_aspect = 16.0f / 9.0f;  ///< the frame's width / height, which the top view fits the map into
 };
 
 /// Builds the frame's scene: floor, walls (merged runs), props by kind, landmarks, the robot, the people and
 /// the avatar with their gaits and shadows, and a third-person camera behind the avatar at the rig's height.
 /// With `style.debug_overlay` and a robot, the navigation overlay (nav_overlay.hpp) follows as the last items;
-/// without, the scene is exactly what it is without the overlay code.
+/// without, the scene is exactly what it is without the overlay code. With `style.top_view` the camera looks
+/// straight down on the map's centre (map +y up in the picture), high enough that the whole map and its
+/// walls fit a frame of `top_view_aspect`, and there is no fog.
 Scene build_scene(const World& world, const SceneStyle& style = {});
 
 /// How one humanoid looks: colours (RGB 0..1) and how broad it is.

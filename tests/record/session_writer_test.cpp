@@ -157,3 +157,9 @@ TEST_CASE("file digests are SHA-256") {
   CHECK(sha256_file(dir / "abc") == "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
   CHECK_THROWS_WITH(sha256_file(dir / "missing"), Catch::Contains("missing"));
 }
+
+TEST_CASE("a folder that already holds a session is not recorded into again") {
+  const auto dir = fresh_dir("twice");
+  { SessionWriter first(dir, tiny_info(), tiny_world()); }
+  CHECK_THROWS_WITH(SessionWriter(dir, tiny_info(), tiny_world()), Catch::Contains("already holds a session"));
+}

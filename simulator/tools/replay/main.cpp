@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// sim_replay: re-runs a recorded session from its log, checks the poses, and films it (docs/replay.md).
+// Parses the command line, runs the replay with a progress line on stderr, and prints the verdict.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "progress_line.hpp"
+#include "replay_cli.hpp"
+#include "replay_job.hpp"
+
+int main(int argc, char** argv) {
+  using namespace rfbsim::replay;
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  CliError error;
+  const std::optional<ReplayOptions> options = parse_cli(args, error);
+  if (!options) {
+    std::fprintf(stderr, "sim_replay: %s\n(sim_replay --help for usage)\n", error.message.c_str());
+    return kExitRefused;
+  }
+  if (options->help) {
+    std::fputs(usage_text().c_str(), stdout);
+    return 0;
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  ProgressLine line(0.0, ::isatty(STDERR_FILENO) == 1);
+  bool line_started = false;
+  ProgressFn progress;
+  if (!options->quiet) {
+    progress = [&](double done_s, double total_s) {
+      if (!line_started) line = ProgressLine(total_s, ::isatty(STDERR_FILENO) == 1);
+      line_started = true;
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::fputs(line.step(done_s, elapsed).c_str(), stderr);
+    };
+  }
+  const ReplayResult result = replay_session(*options, progress);
+  std::fputs(line.finish().c_str(), stderr);
+
+  for (const std::string& warning : result.warnings) std::fprintf(stderr, "sim_replay: warning: %s\n", warning.c_str());
+  if (!result.error.empty()) std::fprintf(stderr, "sim_replay: %s\n", result.error.c_str());
+  for (const std::string& text : result.report) std::printf("%s\n", text.c_str());
+  return result.exit_status;
+}
