@@ -13,6 +13,7 @@
 
 #include "link_signature.hpp"
 #include "pages.hpp"
+#include "proxy_line.hpp"
 #include "query.hpp"
 #include "relay.hpp"
 #include "routes.hpp"
@@ -47,24 +48,16 @@ void close_with(Connection& connection, SessionState state) {
   connection.close(static_cast<CloseCode>(notice.code), notice.reason, ec);
 }
 
-// The PROXY protocol line (version 1) that tells a session which browser a relayed connection is for.
+// The PROXY protocol line that tells a session which browser a relayed connection is for.
 template <typename Connection>
 std::string proxy_line_for(Connection& con) {
   boost::system::error_code ec;
   auto& socket = con.get_raw_socket().lowest_layer();
   const auto remote = socket.remote_endpoint(ec);
-  const auto local = ec ? decltype(remote)() : socket.local_endpoint(ec);
   if (ec) return "PROXY UNKNOWN\r\n";
-  auto source = remote.address();
-  auto destination = local.address();
-  // A dual-stack listener sees IPv4 browsers as ::ffff:a.b.c.d; name them as the IPv4 they are.
-  if (source.is_v6() && source.to_v6().is_v4_mapped()) source = asio::ip::make_address_v4(asio::ip::v4_mapped, source.to_v6());
-  if (destination.is_v6() && destination.to_v6().is_v4_mapped()) {
-    destination = asio::ip::make_address_v4(asio::ip::v4_mapped, destination.to_v6());
-  }
-  if (source.is_v4() != destination.is_v4()) return "PROXY UNKNOWN\r\n";
-  return std::string("PROXY ") + (source.is_v4() ? "TCP4 " : "TCP6 ") + source.to_string() + " " +
-         destination.to_string() + " " + std::to_string(remote.port()) + " " + std::to_string(local.port()) + "\r\n";
+  const auto local = socket.local_endpoint(ec);
+  if (ec) return "PROXY UNKNOWN\r\n";
+  return proxy_line(remote, local);
 }
 
 std::string read_file(const std::filesystem::path& path, bool& ok) {

@@ -56,9 +56,10 @@ export class SurveyReporter {
     if (!this.enabled || this.sent.has(event)) {
       return;
     }
-    // A survey hears 'started' first, whatever came first here: an outcome can be polled before the first
-    // picture shows (a task done at once, or a hidden tab that draws nothing).
-    if (event !== 'started' && !this.sent.has('started')) {
+    // A survey hears 'started' before an outcome, whatever came first here: an outcome can be polled before
+    // the first picture shows (a task done at once, or a hidden tab that draws nothing). A session that
+    // never showed a picture and ended without an outcome (it failed to start) sends 'ended' alone.
+    if ((event === 'completed' || event === 'timeout') && !this.sent.has('started')) {
       this.post('started');
     }
     if (!this.known) {

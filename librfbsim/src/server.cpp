@@ -376,8 +376,9 @@ bool Server::Impl::may_send_update(rfbClientPtr cl, Clock::time_point now) {
   }
   if (!state->backed_up_since) state->backed_up_since = now;
   if (now - *state->backed_up_since >= options.write_timeout) {
-    std::fprintf(stderr, "[rfbsim.server] dropping client %d (%s): it read nothing for %lld ms\n", state->info.id,
-                 state->info.address.c_str(), static_cast<long long>(options.write_timeout.count()));
+    // By id only: the address may be a participant's (from a PROXY line), which logs must not hold.
+    std::fprintf(stderr, "[rfbsim.server] dropping client %d: it read nothing for %lld ms\n", state->info.id,
+                 static_cast<long long>(options.write_timeout.count()));
     ++backed_up_drops;
     rfbCloseClient(cl);
     return false;

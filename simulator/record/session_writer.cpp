@@ -38,6 +38,24 @@ void write_all(int fd, const std::string& bytes, const std::filesystem::path& pa
   }
 }
 
+// Appends `buffer` to `fd` and empties it. When a write fails partway (a full disk), what reached the file
+// leaves the buffer, so that a later flush continues the line instead of writing its start twice.
+void append_buffer(int fd, std::string& buffer, const std::filesystem::path& path) {
+  std::size_t done = 0;
+  while (done < buffer.size()) {
+    const ssize_t n = ::write(fd, buffer.data() + done, buffer.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = errno;
+      buffer.erase(0, done);
+      errno = error;
+      fail(path, "cannot write");
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  buffer.clear();
+}
+
 const char* party_name(Party party) {
   switch (party) {
     case Party::Avatar: return "avatar";
@@ -136,22 +154,18 @@ SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const 
               {"tasks_done", json::array()}};
   write_session_json();
 
-  trajectory_fd_ = open_append(dir_ / "trajectories.csv");
-  events_fd_ = open_append(dir_ / "events.jsonl");
+  trajectory_fd_.fd = open_append(dir_ / "trajectories.csv");
+  events_fd_.fd = open_append(dir_ / "events.jsonl");
   trajectory_buffer_ = "tick,time,kind,id,x,y,yaw,vx,vy\n";
   last_flush_ = std::chrono::steady_clock::now();
-  flush();
+  write_buffers();  // at the start a folder that cannot be written is an error, not a warning
 }
 
-SessionWriter::~SessionWriter() {
-  try {
-    flush();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "[record] %s\n", e.what());
-  }
-  if (trajectory_fd_ >= 0) ::close(trajectory_fd_);
-  if (events_fd_ >= 0) ::close(events_fd_);
+SessionWriter::OwnedFd::~OwnedFd() {
+  if (fd >= 0) ::close(fd);
 }
+
+SessionWriter::~SessionWriter() { flush(); }
 
 void SessionWriter::sample(const World& world) {
   if (world.tick % sample_every_ != 0) return;
@@ -184,13 +198,13 @@ void SessionWriter::world_events(const World& world) {
 
 void SessionWriter::task_done(const std::string& type, std::uint64_t tick) {
   session_["tasks_done"].push_back({{"type", type}, {"tick", tick}, {"time", time_of(tick)}});
-  write_session_json();
+  update_session_json();
 }
 
 void SessionWriter::outcome(const std::string& outcome, const std::string& code, std::uint64_t tick) {
   session_["outcome"] = outcome;
   session_["completion"] = {{"code", code}, {"tick", tick}, {"time", time_of(tick)}};
-  write_session_json();
+  update_session_json();
   flush();  // the outcome is what a study needs most: on disk now, not in half a second
 }
 
@@ -199,7 +213,7 @@ void SessionWriter::finish(const SessionEnd& end) {
   session_["end_tick"] = end.tick;
   session_["end_reason"] = end.reason;
   flush();
-  write_session_json();
+  update_session_json();
 }
 
 void SessionWriter::flush_if_due() {
@@ -209,17 +223,38 @@ void SessionWriter::flush_if_due() {
   }
 }
 
-void SessionWriter::flush() {
+bool SessionWriter::flush() {
+  try {
+    write_buffers();
+    return true;
+  } catch (const std::exception& e) {
+    report_trouble(e.what());
+    return false;
+  }
+}
+
+void SessionWriter::write_buffers() {
   last_flush_ = std::chrono::steady_clock::now();
   // Whole lines per write: a kill between two writes leaves every line complete.
-  if (!trajectory_buffer_.empty()) {
-    write_all(trajectory_fd_, trajectory_buffer_, dir_ / "trajectories.csv");
-    trajectory_buffer_.clear();
+  append_buffer(trajectory_fd_.fd, trajectory_buffer_, dir_ / "trajectories.csv");
+  append_buffer(events_fd_.fd, events_buffer_, dir_ / "events.jsonl");
+}
+
+void SessionWriter::update_session_json() {
+  try {
+    write_session_json();
+  } catch (const std::exception& e) {
+    report_trouble(e.what());
   }
-  if (!events_buffer_.empty()) {
-    write_all(events_fd_, events_buffer_, dir_ / "events.jsonl");
-    events_buffer_.clear();
-  }
+}
+
+void SessionWriter::report_trouble(const std::string& what) {
+  // A full disk must not end the participant's session: say so (not every tick), keep the lines in
+  // memory and try again at the next flush.
+  const auto now = std::chrono::steady_clock::now();
+  if (last_trouble_report_ && now - *last_trouble_report_ < std::chrono::seconds(10)) return;
+  last_trouble_report_ = now;
+  std::fprintf(stderr, "[record] %s; kept in memory, retrying\n", what.c_str());
 }
 
 void SessionWriter::write_session_json() {

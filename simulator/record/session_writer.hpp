@@ -66,23 +66,38 @@ class SessionWriter {
 
   /// Hands buffered lines to the kernel when the flush interval has passed (or the buffer grew large).
   void flush_if_due();
-  /// Hands buffered lines to the kernel now. Throws std::runtime_error when a write fails.
-  void flush();
+  /// Hands buffered lines to the kernel now. False when a write failed (a full disk): the lines not
+  /// written stay buffered for the next flush, and the trouble is logged (at most every 10 s). Never throws:
+  /// the participant's session goes on.
+  bool flush();
 
   [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
   [[nodiscard]] double time_of(std::uint64_t tick) const { return static_cast<double>(tick) / info_.tick_hz; }
 
  private:
   void write_session_json();
+  void update_session_json();  // write_session_json, logging a failure instead of throwing
+  void write_buffers();        // throws std::runtime_error when a write fails
+  void report_trouble(const std::string& what);
+
+  // A descriptor closed with its owner, so that a constructor that throws halfway leaks none.
+  struct OwnedFd {
+    int fd = -1;
+    OwnedFd() = default;
+    OwnedFd(const OwnedFd&) = delete;
+    OwnedFd& operator=(const OwnedFd&) = delete;
+    ~OwnedFd();
+  };
 
   std::filesystem::path dir_;
   SessionInfo info_;
   nlohmann::ordered_json session_;  // session.json as it stands
-  int trajectory_fd_ = -1, events_fd_ = -1;
+  OwnedFd trajectory_fd_, events_fd_;
   std::string trajectory_buffer_, events_buffer_;
   std::uint64_t sample_every_ = 6;
   std::chrono::milliseconds flush_interval_;
   std::chrono::steady_clock::time_point last_flush_;
+  std::optional<std::chrono::steady_clock::time_point> last_trouble_report_;
 };
 
 /// Wall-clock time as ISO 8601 UTC with milliseconds: "2026-11-24T10:15:02.250Z".

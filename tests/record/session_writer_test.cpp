@@ -163,3 +163,20 @@ TEST_CASE("a folder that already holds a session is not recorded into again") {
   { SessionWriter first(dir, tiny_info(), tiny_world()); }
   CHECK_THROWS_WITH(SessionWriter(dir, tiny_info(), tiny_world()), Catch::Contains("already holds a session"));
 }
+
+TEST_CASE("a full disk keeps the lines in memory and the session going, and a first write that fails is an error") {
+  const auto dir = fresh_dir("full");
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_symlink("/dev/full", dir / "events.jsonl");  // every write: ENOSPC
+  World world = tiny_world();
+  SessionWriter writer(dir, tiny_info(), world);
+  writer.event(1, "key", {{"keysym", 119}, {"down", true}, {"client", 1}});
+  CHECK_FALSE(writer.flush());
+  CHECK_NOTHROW(writer.outcome("completed", "A1", 2));  // logged, not thrown
+  CHECK(json::parse(file_text(dir / "session.json"))["outcome"] == "completed");
+
+  const auto header_dir = fresh_dir("full_header");
+  std::filesystem::create_directories(header_dir);
+  std::filesystem::create_symlink("/dev/full", header_dir / "trajectories.csv");
+  CHECK_THROWS_WITH(SessionWriter(header_dir, tiny_info(), world), Catch::Contains("trajectories.csv"));
+}

@@ -191,3 +191,43 @@ TEST_CASE("a sample that lacks an agent's row is left out and counted") {
   CHECK(samples.partial_samples == 1);
   CHECK(session_metrics(log, samples).partial_samples == 1);
 }
+
+TEST_CASE("only the session itself is measured: from the task clock's start to the outcome") {
+  ScratchDir scratch;
+  // The robot stands 0.3 m from the avatar while the page loads (t < 2 s) and again in the grace period
+  // after the outcome (t > 10 s); in between it stands 5.5 m away.
+  SessionSpec spec;
+  spec.samples = 121;  // t = 0.0 .. 12.0
+  spec.tracks = {standing("avatar", 0, 0.3, 2.5, 1.0),
+                 {"robot", 0, 0.16, [](double t) {
+                    return (t < 2.0 || t > 10.0 + 1e-9) ? State{2.5, 1.3, 0.0, 0.0, 0.0} : State{8.0, 1.0, 0.0, 0.0, 0.0};
+                  }}};
+  spec.outcome = "completed";
+  spec.end_tick = 720;
+  spec.events = {event(0, "session", {{"event", "start"}}),
+                 event(60, "contact", {{"a", "avatar"}, {"a_id", 0}, {"b", "robot"}, {"b_id", 0}, {"impulse", 1.0}}),
+                 event(150, "client", {{"event", "connect"}, {"client", 1}, {"address", "0123456789abcdef"}, {"websocket", true}}),
+                 event(150, "timer", {{"event", "started"}}),
+                 event(300, "contact", {{"a", "robot"}, {"a_id", 0}, {"b", "avatar"}, {"b_id", 0}, {"impulse", 1.0}}),
+                 event(420, "robot", {{"state", "arrived"}, {"detail", "goal"}}),
+                 event(600, "outcome", {{"outcome", "completed"}, {"code", "C1"}}),
+                 event(660, "contact", {{"a", "avatar"}, {"a_id", 0}, {"b", "robot"}, {"b_id", 0}, {"impulse", 1.0}})};
+  const auto dir = scratch.path() / "window";
+  write_session(dir, spec);
+  nlohmann::json session = nlohmann::json::parse(read_text(dir / "session.json"));
+  session["completion"] = {{"code", "C1"}, {"tick", 600}, {"time", 10.0}};
+  write_text(dir / "session.json", session.dump(2) + "\n");
+  const rfbsim::sim::SessionLog log = rfbsim::sim::read_session(dir);
+  const SessionMetrics m = session_metrics(log, assemble_samples(log));
+  CHECK(m.measured_from == Approx(2.5));
+  CHECK(m.measured_to == Approx(10.0));
+  CHECK(m.samples == 76);  // ticks 150, 156, ..., 600
+  REQUIRE(m.min_robot_avatar_distance);
+  CHECK(*m.min_robot_avatar_distance == Approx(5.5));
+  CHECK_FALSE(m.robot_within_0_45);
+  CHECK_FALSE(m.robot_within_1_2);
+  CHECK(m.avatar_robot_contacts == 1);
+  REQUIRE(m.time_to_goal);
+  CHECK(*m.time_to_goal == Approx(4.5));
+  CHECK(m.duration == Approx(12.0));
+}

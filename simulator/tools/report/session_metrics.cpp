@@ -16,16 +16,45 @@ bool is_pair(const sim::Event& contact, const char* one, const char* other) {
   return (a == one && b == other) || (a == other && b == one);
 }
 
-// What the events say: contacts, the find_robot step, the robot's arrival.
-void count_events(const sim::SessionLog& log, SessionMetrics& out) {
+// The ticks the measures cover: from the task clock's start (else the first viewer, else 0) to the outcome
+// (else the end of the log).
+struct Window {
+  std::uint64_t from = 0;
+  std::uint64_t to = std::numeric_limits<std::uint64_t>::max();
+};
+
+Window study_window(const sim::SessionLog& log) {
+  Window window;
+  std::optional<std::uint64_t> timer, first_viewer;
   for (const sim::Event& event : log.events) {
+    if (event.type == "timer" && event.text("event") == "started" && !timer) timer = event.tick;
+    if (event.type == "client" && event.text("event") == "connect" && !first_viewer) first_viewer = event.tick;
+  }
+  window.from = timer ? *timer : first_viewer.value_or(0);
+  if (log.meta.completion) window.to = log.meta.completion->tick;
+  return window;
+}
+
+SampledSession within(const SampledSession& all, const Window& window) {
+  SampledSession kept = all;
+  kept.samples.clear();
+  for (const Sample& s : all.samples) {
+    if (s.tick >= window.from && s.tick <= window.to) kept.samples.push_back(s);
+  }
+  return kept;
+}
+
+// What the events say: contacts, the find_robot step, the robot's arrival.
+void count_events(const sim::SessionLog& log, const Window& window, double from_time, SessionMetrics& out) {
+  for (const sim::Event& event : log.events) {
+    if (event.tick < window.from || event.tick > window.to) continue;
     if (event.type == "contact") {
       if (is_pair(event, "avatar", "robot")) ++out.avatar_robot_contacts;
       if (is_pair(event, "avatar", "person")) ++out.avatar_person_collisions;
     } else if (event.type == "task") {
       if (event.text("event") == "done" && event.text("task") == "find_robot") out.found_robot = true;
     } else if (event.type == "robot") {
-      if (event.text("state") == "arrived" && !out.time_to_goal) out.time_to_goal = event.time;
+      if (event.text("state") == "arrived" && !out.time_to_goal) out.time_to_goal = event.time - from_time;
     }
   }
   out.avatar_pushed_robot = out.avatar_robot_contacts > 0;
@@ -67,16 +96,21 @@ SessionMetrics session_metrics(const sim::SessionLog& log, const SampledSession&
   } else if (!log.trajectory.empty()) {
     out.duration = log.trajectory.back().time;
   }
-  out.samples = samples.samples.size();
+  const Window window = study_window(log);
+  const SampledSession measured = within(samples, window);
+  out.measured_from = static_cast<double>(window.from) / meta.tick_hz;
+  out.measured_to = window.to == std::numeric_limits<std::uint64_t>::max() ? out.duration
+                                                                          : static_cast<double>(window.to) / meta.tick_hz;
+  out.samples = measured.samples.size();
   out.partial_samples = samples.partial_samples;
   out.torn_lines = log.torn_lines;
 
   out.timed_out = out.outcome == "timeout";
   out.completed = out.outcome == "completed";
   out.has_robot = samples.has_robot;
-  count_events(log, out);
-  measure_avatar(samples, out);
-  out.robot = robot_metrics(samples);
+  count_events(log, window, out.measured_from, out);
+  measure_avatar(measured, out);
+  out.robot = robot_metrics(measured);
   return out;
 }
 

@@ -28,6 +28,11 @@ struct SessionMetrics {
   std::string end_reason;  ///< completed, timeout, signal, error or "" (did not end cleanly)
   bool ended_cleanly = false;  ///< session.json has ended_at
   double duration = 0.0;       ///< s: end_tick / tick_hz, else the last sample's time
+  /// s: what the measures below cover: from the task clock's start (the participant's first picture; else
+  /// the first viewer; else the world's start) to the outcome (else the end). Before it the participant's
+  /// page was still loading; after it came only the grace period.
+  double measured_from = 0.0;
+  double measured_to = 0.0;
   std::size_t samples = 0;          ///< whole trajectory samples used
   std::size_t partial_samples = 0;  ///< sample ticks left out (someone's row missing or repeated)
   std::size_t torn_lines = 0;       ///< unfinished last lines dropped
@@ -48,7 +53,7 @@ struct SessionMetrics {
 
   // The robot's social-navigation measures; none without a robot or samples.
   std::optional<RobotMetrics> robot;
-  std::optional<double> time_to_goal;  ///< s: the first robot event with state arrived
+  std::optional<double> time_to_goal;  ///< s from measured_from: the first robot event with state arrived
 };
 
 /// Computes a session's metrics from its log and its samples (assemble_samples(log)).

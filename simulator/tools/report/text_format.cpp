@@ -27,6 +27,13 @@ std::string format_number(double value, int decimals) {
 }
 
 std::string csv_field(std::string_view text) {
+  // A text cell a spreadsheet would take for a formula (a uid "-A1", a name "=cmd|...") gets a leading
+  // apostrophe, which spreadsheets show as text; the CSV's own readers see the apostrophe.
+  std::string guarded;
+  if (!text.empty() && (text[0] == '=' || text[0] == '+' || text[0] == '-' || text[0] == '@')) {
+    guarded = "'" + std::string(text);
+    text = guarded;
+  }
   if (text.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(text);
   std::string out = "\"";
   for (const char c : text) {
