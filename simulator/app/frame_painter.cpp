@@ -2,6 +2,8 @@
 // FramePainter: scene, then HUD.
 #include "app/frame_painter.hpp"
 
+#include <algorithm>
+
 namespace rfbsim::sim {
 
 namespace {
@@ -43,8 +45,16 @@ Hud hud_for(const TaskText& text) {
   return hud;
 }
 
+namespace {
+
+// The HUD keeps its share of the picture: 22 px text in a 720-line frame, never under 12 px (legible after
+// JPEG), so that a small frame is not half covered by its panels.
+int hud_body_pixels(int frame_height) { return std::max(12, frame_height * 22 / 720); }
+
+}  // namespace
+
 FramePainter::FramePainter(rfbsim::OffscreenGL& gl, SceneStyle style)
-    : gl_(gl), style_(style), hud_raster_(hud_font_path()) {}
+    : gl_(gl), style_(style), hud_raster_(hud_font_path(), hud_body_pixels(gl.height())) {}
 
 bool FramePainter::paint(const World& world, const TaskText& text, bool always) {
   Scene scene = build_scene(world, style_);
