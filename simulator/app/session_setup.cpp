@@ -50,6 +50,7 @@ PreparedSession prepare_session(const SessionSetup& setup) {
   SessionInfo& info = prepared.info;
   info.tick_hz = setup.tick_hz;
   info.parameters = setup.parameters;
+  if (setup.seed) info.parameters.emplace_back("seed", std::to_string(*setup.seed));
   info.rfbsim_version = rfbsim_version();
   info.build = rfbsim_build_id();
   if (setup.scenario.empty()) {

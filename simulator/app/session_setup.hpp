@@ -22,7 +22,7 @@ struct SessionSetup {
   std::string scenario;  ///< name or path; empty = the built-in test room
   /// Overrides as (link parameter, value): avatar_start, avatar_goal, robot_start, robot_goal, crowd.
   std::vector<std::pair<std::string, std::string>> parameters;
-  std::optional<std::uint64_t> seed;  ///< unset = the scenario's
+  std::optional<std::uint64_t> seed;  ///< unset = the scenario's (and its crowd's own, if it has one)
   int tick_hz = 60;
   std::optional<double> time_limit;  ///< s, overrides the scenario's task time limit
 };
@@ -31,7 +31,10 @@ struct SessionSetup {
 struct PreparedSession {
   std::unique_ptr<Simulation> simulation;
   TaskSpec task;
-  SessionInfo info;  ///< session.json's header, less what the caller knows (uid, fps, frame, codes)
+  /// session.json's header, less what the caller knows (uid, fps, frame, codes). Its parameters are the
+  /// setup's, plus "seed" when the setup gave one: what a replay needs to build the same world (a seed
+  /// override also replaces a crowd's own seed, so "given" and "the file's" are not the same).
+  SessionInfo info;
 };
 
 /// Loads the scenario (found by name in the source and installed scenario folders, or as a path),

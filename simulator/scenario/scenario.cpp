@@ -358,9 +358,7 @@ std::filesystem::path find_scenario(const std::string& name_or_path,
 
 void apply_overrides(Scenario& scenario, const ScenarioOverrides& overrides) {
   const GridMap obstacles = obstacles_of(scenario);
-  // A seed other than the file's replaces it, the crowd's included. The file's own seed changes nothing, so
-  // that a session recorded without --seed (whose session.json names the file's seed) replays with it.
-  if (overrides.seed && *overrides.seed != scenario.seed) {
+  if (overrides.seed) {
     scenario.seed = *overrides.seed;
     scenario.crowd.seed = *overrides.seed;
   }

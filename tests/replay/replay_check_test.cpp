@@ -47,9 +47,11 @@ test::Recording record_lab_timeout(const std::filesystem::path& dir, const std::
 }
 
 // A short lab session ended by a signal at tick 240: enough for the checks on provenance and tampering.
-test::Recording record_lab_short(const std::filesystem::path& dir, const std::string& scenario = "lab") {
+test::Recording record_lab_short(const std::filesystem::path& dir, const std::string& scenario = "lab",
+                                 std::optional<std::uint64_t> seed = std::nullopt) {
   test::RecordSpec spec;
   spec.scenario = scenario;
+  spec.seed = seed;
   spec.max_ticks = 240;
   spec.script = [](sim::StudySession& study, std::uint64_t tick) {
     if (tick == 10) study.key('w', true, 1);
@@ -234,11 +236,32 @@ TEST_CASE("a scenario whose crowd has a seed of its own replays with the crowd i
   test::write_lines(scenario_dir / "lab.yaml", yaml);
   const auto dir = test::fresh_dir("crowd_seed_session");
   record_lab_short(dir, (scenario_dir / "lab.yaml").string());
+  CHECK_FALSE(read_json(dir / "session.json")["parameters"].contains("seed"));
 
   const test::ReplayRun run = test::run_replay({dir.string()});
   INFO(run.output);
   CHECK(run.exit_code == 0);
   CHECK(contains(run.output, "poses match the log"));
+
+  // --seed with the file's own master seed still replaces the crowd's seed; the log says it was given.
+  const auto given = test::fresh_dir("crowd_seed_given");
+  record_lab_short(given, (scenario_dir / "lab.yaml").string(), 1);
+  CHECK(read_json(given / "session.json")["parameters"]["seed"] == "1");
+  CHECK(test::read_lines(given / "trajectories.csv") != test::read_lines(dir / "trajectories.csv"));
+  const test::ReplayRun given_run = test::run_replay({given.string()});
+  INFO(given_run.output);
+  CHECK(given_run.exit_code == 0);
+  CHECK(contains(given_run.output, "poses match the log"));
+
+  // A seed parameter that is not a 64-bit decimal is bad data: a clear refusal.
+  json session = read_json(given / "session.json");
+  session["parameters"]["seed"] = "12x";
+  write_json(given / "session.json", session);
+  const test::ReplayRun bad = test::run_replay({given.string()});
+  INFO(bad.output);
+  CHECK(bad.exit_code == 2);
+  CHECK(contains(bad.output, "parameters.seed"));
+  CHECK(contains(bad.output, "12x"));
 }
 
 TEST_CASE("a trajectory with one number changed fails the check with the line that differs") {

@@ -25,6 +25,7 @@ Recording record_session(const RecordSpec& spec, const std::filesystem::path& di
   sim::SessionSetup setup;
   setup.scenario = spec.scenario;
   setup.parameters = spec.parameters;
+  setup.seed = spec.seed;
   setup.time_limit = spec.time_limit;
   sim::PreparedSession prepared = sim::prepare_session(setup);
   sim::Simulation& simulation = *prepared.simulation;

@@ -22,6 +22,7 @@ std::filesystem::path fresh_dir(const std::string& name);
 struct RecordSpec {
   std::string scenario = "lab";  ///< name or path
   std::vector<std::pair<std::string, std::string>> parameters;
+  std::optional<std::uint64_t> seed;  ///< as sim_rfb's --seed; unset = the scenario's
   std::optional<double> time_limit;  ///< s
   int width = 320, height = 240;     ///< the frame session.json records (the video's size)
   std::uint64_t connect_tick = 0;    ///< when the viewer arrives (and the task clock starts)

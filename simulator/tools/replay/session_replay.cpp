@@ -2,6 +2,7 @@
 // SessionReplay: the recorded inputs, applied at their ticks.
 #include "session_replay.hpp"
 
+#include <charconv>
 #include <limits>
 #include <stdexcept>
 
@@ -24,8 +25,21 @@ int small_int(const sim::Event& event, const char* key) {
 sim::SessionSetup setup_of(const sim::SessionMeta& meta) {
   sim::SessionSetup setup;
   setup.scenario = meta.scenario_file;
-  for (const auto& [name, value] : meta.parameters) setup.parameters.emplace_back(name, value);
-  setup.seed = meta.seed;
+  // The parameters as sim_rfb was given them: "seed" only when one was (it then replaces a crowd's own seed
+  // too, so the recorded master seed alone would not say which crowd ran).
+  for (const auto& [name, value] : meta.parameters) {
+    if (name == "seed") {
+      std::uint64_t seed = 0;
+      const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), seed);
+      if (ec != std::errc() || end != value.data() + value.size() || value.empty()) {
+        throw sim::SessionLogError("session.json: key 'parameters.seed': expected a decimal 64-bit seed, got '" +
+                                   value + "'");
+      }
+      setup.seed = seed;
+    } else {
+      setup.parameters.emplace_back(name, value);
+    }
+  }
   setup.tick_hz = meta.tick_hz;
   setup.time_limit = meta.time_limit_s;
   return setup;
