@@ -42,12 +42,10 @@ void StudySession::client_disconnected(int client, const std::string& address_ha
 void StudySession::step() {
   simulation_.step();
   monitor_.observe(simulation_.world());
-  if (writer_ == nullptr) {
-    monitor_.clear_events();
-    return;
+  if (writer_ != nullptr) {
+    writer_->sample(simulation_.world());
+    writer_->world_events(simulation_.world());
   }
-  writer_->sample(simulation_.world());
-  writer_->world_events(simulation_.world());
   record_task_events();
 }
 

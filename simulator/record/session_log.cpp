@@ -389,6 +389,13 @@ bool Event::flag(const char* key) const {
   return it != fields.end() && it->is_boolean() && it->get<bool>();
 }
 
+std::vector<std::string> read_complete_lines(const std::filesystem::path& file) {
+  const std::string bytes = read_file(file);
+  std::size_t torn = 0;
+  const std::vector<std::string_view> views = complete_lines(bytes, torn);
+  return {views.begin(), views.end()};
+}
+
 SessionLog read_session(const std::filesystem::path& dir) {
   SessionLog log;
   log.dir = dir;

@@ -127,6 +127,11 @@ struct SessionLog {
 /// nothing else) when a file is missing, unreadable or not as docs/data.md describes.
 SessionLog read_session(const std::filesystem::path& dir);
 
+/// The complete lines of an appended session file (trajectories.csv, events.jsonl), without their newlines;
+/// a last line without its newline (a write cut short by a kill) is dropped. Throws SessionLogError for a
+/// missing, unreadable or oversized file.
+std::vector<std::string> read_complete_lines(const std::filesystem::path& file);
+
 /// Every folder under `data_dir` (recursively, without following links) that holds a session.json,
 /// sorted. Folders that cannot be read are passed over; none when `data_dir` is not a folder.
 std::vector<std::filesystem::path> find_session_dirs(const std::filesystem::path& data_dir);

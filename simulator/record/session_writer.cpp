@@ -28,16 +28,6 @@ int open_append(const std::filesystem::path& path) {
   return fd;
 }
 
-void write_all(int fd, const std::string& bytes, const std::filesystem::path& path) {
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) fail(path, "cannot write");
-    done += static_cast<std::size_t>(n);
-  }
-}
-
 // Appends `buffer` to `fd` and empties it. When a write fails partway (a full disk), what reached the file
 // leaves the buffer, so that a later flush continues the line instead of writing its start twice.
 void append_buffer(int fd, std::string& buffer, const std::filesystem::path& path) {
@@ -265,7 +255,8 @@ void SessionWriter::write_session_json() {
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) fail(temporary, "cannot open for writing");
   try {
-    write_all(fd, session_.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n", temporary);
+    std::string text = session_.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+    append_buffer(fd, text, temporary);
   } catch (...) {
     ::close(fd);
     throw;

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "render/gl_program.hpp"
+
 namespace rfbsim::sim {
 
 namespace {
@@ -40,20 +42,6 @@ void main() {
 }
 )";
 
-GLuint compile(GLenum type, const char* source) {
-  const GLuint shader = glCreateShader(type);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (ok == 0) {
-    std::string log(4096, '\0');
-    glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
-    glDeleteShader(shader);
-    throw std::runtime_error("HUD shader compile failed: " + std::string(log.c_str()));
-  }
-  return shader;
-}
 
 // The state draw() changes, read before and put back after, so that the layer can sit between any two
 // draws. Queries are cheap on a software rasterizer and cost a sync at most once a frame on a GPU.
@@ -119,17 +107,7 @@ struct GlHudLayer::Impl {
 };
 
 GlHudLayer::GlHudLayer() : impl_(std::make_unique<Impl>()) {
-  const GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader);
-  const GLuint fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
-  impl_->program = glCreateProgram();
-  glAttachShader(impl_->program, vs);
-  glAttachShader(impl_->program, fs);
-  glLinkProgram(impl_->program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(impl_->program, GL_LINK_STATUS, &ok);
-  if (ok == 0) throw std::runtime_error("HUD shader link failed");
+  impl_->program = link_gl_program(kVertexShader, kFragmentShader, "HUD shader");
   impl_->u_rect = glGetUniformLocation(impl_->program, "u_rect");
   impl_->u_frame = glGetUniformLocation(impl_->program, "u_frame");
   impl_->u_image = glGetUniformLocation(impl_->program, "u_image");

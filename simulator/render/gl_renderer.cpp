@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "render/draw_batches.hpp"
+#include "render/gl_program.hpp"
 #include "render/unit_meshes.hpp"
 
 namespace rfbsim::sim {
@@ -155,20 +156,6 @@ void point_instances_at(std::size_t first) {
   glVertexAttribPointer(location, 1, GL_FLOAT, GL_FALSE, stride, at(offsetof(InstanceAttributes, surface)));
 }
 
-GLuint compile(GLenum type, const char* source) {
-  const GLuint shader = glCreateShader(type);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (ok == 0) {
-    std::string log(4096, '\0');
-    glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
-    glDeleteShader(shader);
-    throw std::runtime_error("shader compile failed: " + std::string(log.c_str()));
-  }
-  return shader;
-}
 
 }  // namespace
 
@@ -206,17 +193,7 @@ struct GlRenderer::Impl {
 };
 
 GlRenderer::GlRenderer() : impl_(std::make_unique<Impl>()) {
-  const GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader);
-  const GLuint fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
-  impl_->program = glCreateProgram();
-  glAttachShader(impl_->program, vs);
-  glAttachShader(impl_->program, fs);
-  glLinkProgram(impl_->program);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(impl_->program, GL_LINK_STATUS, &ok);
-  if (ok == 0) throw std::runtime_error("shader link failed");
+  impl_->program = link_gl_program(kVertexShader, kFragmentShader, "shader");
   const auto uniform = [&](const char* name) { return glGetUniformLocation(impl_->program, name); };
   impl_->u_view_projection = uniform("u_view_projection");
   impl_->u_sun = uniform("u_sun");

@@ -15,14 +15,13 @@
 // Exits 0 when every check passed, 1 on the first failed check, 2 on the overall timeout.
 
 import fs from 'node:fs';
-import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 
 import {
-  PIXEL_CHANGE_THRESHOLD, changedFraction, check, launchBrowser, log, onCleanup, openPage, pageState, poll,
-  prepare, recordPage, runTest, sleep, snapshot, startSim, stopSimCleanly, waitForConnection, waitForPicture,
+  PIXEL_CHANGE_THRESHOLD, changedFraction, check, launchBrowser, log, onCleanup, openPage, pageState,
+  parseManagerArgs, poll, prepare, recordPage, runTest, serveHtmlPage, sleep, snapshot, startSim, stopSimCleanly,
+  waitForConnection, waitForPicture,
 } from './e2e_support.mjs';
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -40,23 +39,8 @@ const VIEWPORT = { width: 1024, height: 720 };
 const SURVEY_FRAME = { width: 800, height: 450 };
 const TOKEN_PATH = /^\/s\/([0-9a-f]{32})\/$/;
 
-const here = path.dirname(fileURLToPath(import.meta.url));
 
-function parseManagerArgs() {
-  const [managerPath, simRfbPath, webRoot, artifactsArg, webArg] = process.argv.slice(2);
-  if (!managerPath || !simRfbPath || !webRoot || !artifactsArg) {
-    console.error('usage: node e2e_manager.mjs SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]');
-    process.exit(1);
-  }
-  return {
-    simPath: managerPath,   // what startSim starts: here, sim_manager
-    simRfbPath: path.resolve(simRfbPath),
-    webRoot: path.resolve(webRoot),
-    artifacts: path.resolve(artifactsArg),
-    webDir: path.resolve(webArg || path.join(here, '..', '..', 'web')),
-  };
-}
-const env = parseManagerArgs();
+const env = parseManagerArgs('e2e_manager.mjs');
 
 // ---------------------------------------------------------------------------------------------------------------
 // Helpers: the manager's HTTP API, the session processes, the survey servers.
@@ -141,30 +125,9 @@ function surveyPage(link) {
 `;
 }
 
-// Starts a tiny HTTP server on a free loopback port that serves /survey?uid=U (embedding U's session link).
-// Resolves with { server, origin }; cleanup closes it.
-async function startSurveyServer(name) {
-  const server = http.createServer((req, res) => {
-    const url = new URL(req.url, 'http://survey');
-    if (url.pathname !== '/survey') {
-      res.writeHead(404, { 'Content-Type': 'text/plain' });
-      res.end('not found\n');
-      return;
-    }
-    res.writeHead(200, { 'Content-Type': 'text/html; charset=utf-8', 'Cache-Control': 'no-store' });
-    res.end(surveyPage(startLink(url.searchParams.get('uid') || '')));
-  });
-  await new Promise((resolve, reject) => {
-    server.once('error', reject);
-    server.listen(0, '127.0.0.1', resolve);
-  });
-  onCleanup(() => new Promise((resolve) => {
-    server.closeAllConnections();
-    server.close(resolve);
-  }));
-  const origin = `http://127.0.0.1:${server.address().port}`;
-  log(`${name} serves ${origin}/survey`);
-  return { server, origin };
+// The survey test page on its own loopback origin: /survey?uid=U embeds U's session link.
+function startSurveyServer(name) {
+  return serveHtmlPage(name, '/survey', (url) => surveyPage(startLink(url.searchParams.get('uid') || '')));
 }
 
 // Records every text the page's progress line shows (in every frame), with when: window.__e2eStatusSeen.

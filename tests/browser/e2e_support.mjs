@@ -9,6 +9,7 @@
 
 import { spawn } from 'node:child_process';
 import fs from 'node:fs';
+import http from 'node:http';
 import { createRequire } from 'node:module';
 import os from 'node:os';
 import path from 'node:path';
@@ -109,6 +110,23 @@ export function parseArgs(scriptName) {
   }
   return {
     simPath,
+    artifacts: path.resolve(artifactsArg),
+    webDir: path.resolve(webArg || path.join(here, '..', '..', 'web')),
+  };
+}
+
+// The arguments of the sim_manager tests: SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]. Returns
+// { simPath (sim_manager: what startSim starts), simRfbPath, webRoot, artifacts, webDir }, paths absolute.
+export function parseManagerArgs(scriptName) {
+  const [managerPath, simRfbPath, webRoot, artifactsArg, webArg] = process.argv.slice(2);
+  if (!managerPath || !simRfbPath || !webRoot || !artifactsArg) {
+    console.error(`usage: node ${scriptName} SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]`);
+    process.exit(1);
+  }
+  return {
+    simPath: managerPath,
+    simRfbPath: path.resolve(simRfbPath),
+    webRoot: path.resolve(webRoot),
     artifacts: path.resolve(artifactsArg),
     webDir: path.resolve(webArg || path.join(here, '..', '..', 'web')),
   };
@@ -503,6 +521,33 @@ function reportFailure(message, exitCode) {
 
 // Runs main() under an overall timeout (RFBSIM_E2E_TIMEOUT_S, else defaultTimeoutS), prints PASS or FAIL,
 // cleans up and exits the process: 0 passed, 1 a check failed or interrupted, 2 overall timeout.
+// Starts a tiny HTTP server on a free loopback port, standing in for a survey site on its own origin: GET
+// `pathname` answers the HTML that page(url) returns, anything else 404. Resolves with { server, origin };
+// cleanup closes it.
+export async function serveHtmlPage(name, pathname, page) {
+  const server = http.createServer((req, res) => {
+    const url = new URL(req.url, 'http://survey');
+    if (url.pathname !== pathname) {
+      res.writeHead(404, { 'Content-Type': 'text/plain' });
+      res.end('not found\n');
+      return;
+    }
+    res.writeHead(200, { 'Content-Type': 'text/html; charset=utf-8', 'Cache-Control': 'no-store' });
+    res.end(page(url));
+  });
+  await new Promise((resolve, reject) => {
+    server.once('error', reject);
+    server.listen(0, '127.0.0.1', resolve);
+  });
+  onCleanup(() => new Promise((resolve) => {
+    server.closeAllConnections();
+    server.close(resolve);
+  }));
+  const origin = `http://127.0.0.1:${server.address().port}`;
+  log(`${name} serves ${origin}${pathname}`);
+  return { server, origin };
+}
+
 export async function runTest(testName, defaultTimeoutS, main) {
   const overallTimeoutMs = 1000 * Number(process.env.RFBSIM_E2E_TIMEOUT_S || defaultTimeoutS);
   const watchdog = setTimeout(() => {

@@ -17,13 +17,12 @@
 // Exits 0 when every check passed, 1 on the first failed check, 2 on the overall timeout.
 
 import fs from 'node:fs';
-import http from 'node:http';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 import {
-  check, launchBrowser, log, onCleanup, pageState, poll, prepare, recordPage, runTest, sleep, startSim,
-  stopSimCleanly,
+  check, launchBrowser, log, onCleanup, pageState, parseManagerArgs, poll, prepare, recordPage, runTest,
+  serveHtmlPage, sleep, startSim, stopSimCleanly,
 } from './e2e_support.mjs';
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -45,49 +44,15 @@ const SILENCE_MS = 6000;                // how long the refused survey must hear
 const VIEWPORT = { width: 1100, height: 900 };
 const TOKEN_PATH = /^\/s\/[0-9a-f]{32}\/$/;
 
-function parseSurveyArgs() {
-  const [managerPath, simRfbPath, webRoot, artifactsArg, webArg] = process.argv.slice(2);
-  if (!managerPath || !simRfbPath || !webRoot || !artifactsArg) {
-    console.error('usage: node e2e_survey.mjs SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]');
-    process.exit(1);
-  }
-  return {
-    simPath: managerPath,   // what startSim starts: here, sim_manager
-    simRfbPath: path.resolve(simRfbPath),
-    webRoot: path.resolve(webRoot),
-    artifacts: path.resolve(artifactsArg),
-    webDir: path.resolve(webArg || path.join(here, '..', '..', 'web')),
-  };
-}
-const env = parseSurveyArgs();
+const env = parseManagerArgs('e2e_survey.mjs');
 
 // ---------------------------------------------------------------------------------------------------------------
 // Helpers.
 // ---------------------------------------------------------------------------------------------------------------
 
-// Starts a tiny HTTP server on a free loopback port that serves /survey-demo.html (and nothing else).
-// Resolves with its origin; cleanup closes it.
+// The demo survey on its own loopback origin, standing in for the survey site. Resolves with the origin.
 async function startDemoServer(name, demoFile) {
-  const server = http.createServer((req, res) => {
-    const url = new URL(req.url, 'http://survey');
-    if (url.pathname !== '/survey-demo.html') {
-      res.writeHead(404, { 'Content-Type': 'text/plain' });
-      res.end('not found\n');
-      return;
-    }
-    res.writeHead(200, { 'Content-Type': 'text/html; charset=utf-8', 'Cache-Control': 'no-store' });
-    res.end(fs.readFileSync(demoFile));
-  });
-  await new Promise((resolve, reject) => {
-    server.once('error', reject);
-    server.listen(0, '127.0.0.1', resolve);
-  });
-  onCleanup(() => new Promise((resolve) => {
-    server.closeAllConnections();
-    server.close(resolve);
-  }));
-  const origin = `http://127.0.0.1:${server.address().port}`;
-  log(`${name} serves ${origin}/survey-demo.html`);
+  const { origin } = await serveHtmlPage(name, '/survey-demo.html', () => fs.readFileSync(demoFile));
   return origin;
 }
 

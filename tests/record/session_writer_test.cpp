@@ -12,17 +12,13 @@
 
 #include "record/digest.hpp"
 #include "record/session_writer.hpp"
+#include "scratch_dir.hpp"
 
 using namespace rfbsim::sim;
+using rfbsim::test::ScratchDir;
 using nlohmann::json;
 
 namespace {
-
-std::filesystem::path fresh_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("rfbsim_writer_" + std::to_string(::getpid())) / name;
-  std::filesystem::remove_all(dir);
-  return dir;
-}
 
 std::string file_text(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -55,7 +51,8 @@ SessionInfo tiny_info() {
 }  // namespace
 
 TEST_CASE("rows and events reach the files at a flush, whole lines only, every sixth tick sampled") {
-  const auto dir = fresh_dir("flush");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "flush";
   World world = tiny_world();
   SessionWriter writer(dir, tiny_info(), world, std::chrono::hours(1));
   CHECK(file_text(dir / "trajectories.csv") == "tick,time,kind,id,x,y,yaw,vx,vy\n");
@@ -81,7 +78,8 @@ TEST_CASE("rows and events reach the files at a flush, whole lines only, every s
 }
 
 TEST_CASE("the flush interval hands lines to the kernel without an explicit flush") {
-  const auto dir = fresh_dir("interval");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "interval";
   World world = tiny_world();
   SessionWriter writer(dir, tiny_info(), world, std::chrono::milliseconds(1));
   writer.event(0, "session", {{"event", "start"}});
@@ -91,7 +89,8 @@ TEST_CASE("the flush interval hands lines to the kernel without an explicit flus
 }
 
 TEST_CASE("session.json is complete from the start and gains the outcome, tasks and end") {
-  const auto dir = fresh_dir("session");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "session";
   World world = tiny_world();
   SessionInfo info = tiny_info();
   info.codes = std::make_pair(std::string("A1"), std::string("B2"));
@@ -120,7 +119,8 @@ TEST_CASE("session.json is complete from the start and gains the outcome, tasks 
 }
 
 TEST_CASE("text from outside that is not UTF-8 is written replaced, never thrown") {
-  const auto dir = fresh_dir("utf8");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "utf8";
   World world = tiny_world();
   SessionWriter writer(dir, tiny_info(), world);
   writer.event(1, "robot", {{"state", "failed"}, {"detail", std::string("bad \xff byte")}});
@@ -132,7 +132,8 @@ TEST_CASE("text from outside that is not UTF-8 is written replaced, never thrown
 TEST_CASE("a trajectory rate that does not divide the tick rate is refused") {
   SessionInfo info = tiny_info();
   info.trajectory_hz = 7;
-  CHECK_THROWS_WITH(SessionWriter(fresh_dir("rate"), info, tiny_world()), Catch::Contains("7 Hz"));
+  ScratchDir scratch;
+  CHECK_THROWS_WITH(SessionWriter(scratch.path() / "rate", info, tiny_world()), Catch::Contains("7 Hz"));
 }
 
 TEST_CASE("addresses hash alike under one key, differently under another, and never show") {
@@ -151,7 +152,8 @@ TEST_CASE("addresses hash alike under one key, differently under another, and ne
 }
 
 TEST_CASE("file digests are SHA-256") {
-  const auto dir = fresh_dir("digest");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "digest";
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "abc") << "abc";
   CHECK(sha256_file(dir / "abc") == "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
@@ -159,13 +161,15 @@ TEST_CASE("file digests are SHA-256") {
 }
 
 TEST_CASE("a folder that already holds a session is not recorded into again") {
-  const auto dir = fresh_dir("twice");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "twice";
   { SessionWriter first(dir, tiny_info(), tiny_world()); }
   CHECK_THROWS_WITH(SessionWriter(dir, tiny_info(), tiny_world()), Catch::Contains("already holds a session"));
 }
 
 TEST_CASE("a full disk keeps the lines in memory and the session going, and a first write that fails is an error") {
-  const auto dir = fresh_dir("full");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "full";
   std::filesystem::create_directories(dir);
   std::filesystem::create_symlink("/dev/full", dir / "events.jsonl");  // every write: ENOSPC
   World world = tiny_world();
@@ -175,7 +179,7 @@ TEST_CASE("a full disk keeps the lines in memory and the session going, and a fi
   CHECK_NOTHROW(writer.outcome("completed", "A1", 2));  // logged, not thrown
   CHECK(json::parse(file_text(dir / "session.json"))["outcome"] == "completed");
 
-  const auto header_dir = fresh_dir("full_header");
+  const auto header_dir = scratch.path() / "full_header";
   std::filesystem::create_directories(header_dir);
   std::filesystem::create_symlink("/dev/full", header_dir / "trajectories.csv");
   CHECK_THROWS_WITH(SessionWriter(header_dir, tiny_info(), world), Catch::Contains("trajectories.csv"));

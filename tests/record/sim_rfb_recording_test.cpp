@@ -15,17 +15,13 @@
 #include "http_client.hpp"
 #include "rfb_test_client.hpp"
 #include "sim_process.hpp"
+#include "scratch_dir.hpp"
 
 using nlohmann::json;
+using rfbsim::test::ScratchDir;
 using rfbsim::test::SimProcess;
 
 namespace {
-
-std::filesystem::path fresh_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("rfbsim_recording_" + std::to_string(::getpid())) / name;
-  std::filesystem::remove_all(dir);
-  return dir;
-}
 
 // Complete lines only: a last line without its newline is a write the kill cut short.
 std::vector<std::string> complete_lines(const std::filesystem::path& file) {
@@ -52,7 +48,8 @@ std::uint64_t current_tick(int port) {
 }  // namespace
 
 TEST_CASE("sim_rfb killed with SIGKILL leaves readable session files up to its last second") {
-  const auto dir = fresh_dir("killed");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "killed";
   SimProcess sim(rfbsim::test::sim_rfb_path(),
                  {"--port", "0", "--scenario", "lab", "--data-dir", dir.string(), "--uid", "p-killed"});
   std::this_thread::sleep_for(std::chrono::milliseconds(2500));
@@ -83,7 +80,8 @@ TEST_CASE("sim_rfb killed with SIGKILL leaves readable session files up to its l
 }
 
 TEST_CASE("sim_rfb ended with SIGTERM writes the end, and records a viewer with its address hashed") {
-  const auto dir = fresh_dir("terminated");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "terminated";
   SimProcess sim(rfbsim::test::sim_rfb_path(), {"--port", "0", "--scenario", "lab", "--data-dir", dir.string()});
   {
     rfbsim::test::RfbTestClient client("127.0.0.1", sim.port());

@@ -8,13 +8,14 @@
 #include <stdexcept>
 #include <string>
 
-namespace rfbsim::manager::test {
+namespace rfbsim::test {
 
 /// A unique folder under the system's temp directory (mkdtemp), removed at scope exit.
 class ScratchDir {
  public:
-  ScratchDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "rfbsim_manager_unit_XXXXXX").string();
+  /// `prefix` starts the folder's name (then six random characters).
+  explicit ScratchDir(const std::string& prefix = "rfbsim_test") {
+    std::string pattern = (std::filesystem::temp_directory_path() / (prefix + "_XXXXXX")).string();
     if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed for " + pattern);
     // Canonical, so that it compares equal to what a child's pwd prints even if /tmp is a link.
     dir_ = std::filesystem::canonical(pattern);
@@ -50,4 +51,4 @@ class ScratchDir {
   std::filesystem::path dir_;
 };
 
-}  // namespace rfbsim::manager::test
+}  // namespace rfbsim::test

@@ -13,19 +13,15 @@
 
 #include "app/session_setup.hpp"
 #include "app/study_session.hpp"
+#include "scratch_dir.hpp"
 
 using namespace rfbsim::sim;
+using rfbsim::test::ScratchDir;
 using nlohmann::json;
 
 namespace {
 
 constexpr std::uint32_t kKeyW = 'w', kKeyA = 'a', kKeyUp = 0xff52;
-
-std::filesystem::path fresh_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("rfbsim_study_" + std::to_string(::getpid())) / name;
-  std::filesystem::remove_all(dir);
-  return dir;
-}
 
 std::vector<std::string> lines_of(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -62,7 +58,8 @@ TEST_CASE("a scripted participant completes the tutorial, and the session data t
   setup.parameters = {{"avatar_goal", "8.4,5.4"}};  // 1 m back toward the start, reached after the turn
   PreparedSession prepared = prepare_session(setup);
   Simulation& simulation = *prepared.simulation;
-  const auto dir = fresh_dir("tutorial");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "tutorial";
   std::map<std::uint64_t, std::string> expected_rows;  // the avatar's row at every sample tick, from the world
   {
     SessionWriter writer(dir, info_for(prepared, "p-tutorial"), simulation.world());
@@ -153,7 +150,8 @@ TEST_CASE("a participant who does nothing in the lab times out at the limit and 
   setup.time_limit = 3.0;
   PreparedSession prepared = prepare_session(setup);
   Simulation& simulation = *prepared.simulation;
-  const auto dir = fresh_dir("lab_timeout");
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "lab_timeout";
   {
     SessionWriter writer(dir, info_for(prepared, "p-idle"), simulation.world());
     StudySession study(simulation, prepared.task, {"OK-1", "LATE-2"}, &writer);

@@ -2,36 +2,12 @@
 // sim_replay's command line.
 #include "replay_cli.hpp"
 
+#include "cli_option.hpp"
+
 namespace rfbsim::replay {
 
-namespace {
-
-// "--name VALUE" or "--name=VALUE": the value, or none with `error` set. `i` moves past a separate value.
-std::optional<std::string> option_value(const std::vector<std::string>& args, std::size_t& i, const std::string& name,
-                                        const char* what, CliError& error) {
-  const std::string& arg = args[i];
-  std::string value;
-  if (arg == name) {
-    if (i + 1 >= args.size()) {
-      error.message = name + " needs " + what;
-      return std::nullopt;
-    }
-    value = args[++i];
-  } else {
-    value = arg.substr(name.size() + 1);
-  }
-  if (value.empty()) {
-    error.message = name + " needs " + what;
-    return std::nullopt;
-  }
-  return value;
-}
-
-bool is_option(const std::string& arg, const std::string& name) {
-  return arg == name || arg.rfind(name + "=", 0) == 0;
-}
-
-}  // namespace
+using tools::is_option;
+using tools::option_value;
 
 std::optional<ReplayOptions> parse_cli(const std::vector<std::string>& args, CliError& error) {
   ReplayOptions options;
@@ -49,15 +25,15 @@ std::optional<ReplayOptions> parse_cli(const std::vector<std::string>& args, Cli
       options.help = true;
       return options;
     } else if (is_option(arg, "--video")) {
-      const auto value = option_value(args, i, "--video", "a file name (out.mp4)", error);
+      const auto value = option_value(args, i, "--video", "a file name (out.mp4)", error.message);
       if (!value) return std::nullopt;
       options.video = *value;
     } else if (is_option(arg, "--out-dir")) {
-      const auto value = option_value(args, i, "--out-dir", "a folder", error);
+      const auto value = option_value(args, i, "--out-dir", "a folder", error.message);
       if (!value) return std::nullopt;
       options.out_dir = *value;
     } else if (is_option(arg, "--view")) {
-      const auto value = option_value(args, i, "--view", "participant or top", error);
+      const auto value = option_value(args, i, "--view", "participant or top", error.message);
       if (!value) return std::nullopt;
       if (*value == "participant") {
         options.view = View::Participant;

@@ -2,9 +2,10 @@
 // TrajectoryDiff: two trajectories.csv files, line by line.
 #include "trajectory_diff.hpp"
 
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
+
+#include "record/session_log.hpp"
 
 namespace rfbsim::replay {
 
@@ -12,20 +13,14 @@ namespace {
 
 constexpr const char* kEndOfFile = "(end of file)";
 
-// The file's complete lines (a last line without its newline is dropped).
+// The file's complete lines (session_log's rule: a torn last line is dropped). A file that cannot be read
+// here, after the session was read once, is a failure of the run, not bad session data.
 std::vector<std::string> complete_lines(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw std::runtime_error(file.string() + ": cannot read");
-  std::stringstream whole;
-  whole << in.rdbuf();
-  const std::string text = whole.str();
-  std::vector<std::string> lines;
-  std::size_t start = 0;
-  for (std::size_t end = text.find('\n'); end != std::string::npos; end = text.find('\n', start)) {
-    lines.push_back(text.substr(start, end - start));
-    start = end + 1;
+  try {
+    return sim::read_complete_lines(file);
+  } catch (const sim::SessionLogError& e) {
+    throw std::runtime_error(e.what());
   }
-  return lines;
 }
 
 std::vector<std::string> cells_of(const std::string& line) {

@@ -2,6 +2,8 @@
 // sim_report's command line.
 #include "report_cli.hpp"
 
+#include "cli_option.hpp"
+
 namespace rfbsim::report {
 
 std::optional<CliOptions> parse_cli(const std::vector<std::string>& args, CliError& error) {
@@ -18,22 +20,10 @@ std::optional<CliOptions> parse_cli(const std::vector<std::string>& args, CliErr
     } else if (arg == "--help" || arg == "-h") {
       options.help = true;
       return options;
-    } else if (arg == "--out" || arg.rfind("--out=", 0) == 0) {
-      std::string value;
-      if (arg == "--out") {
-        if (i + 1 >= args.size()) {
-          error.message = "--out needs a folder";
-          return std::nullopt;
-        }
-        value = args[++i];
-      } else {
-        value = arg.substr(6);
-      }
-      if (value.empty()) {
-        error.message = "--out needs a folder";
-        return std::nullopt;
-      }
-      options.out_dir = value;
+    } else if (tools::is_option(arg, "--out")) {
+      const auto value = tools::option_value(args, i, "--out", "a folder", error.message);
+      if (!value) return std::nullopt;
+      options.out_dir = *value;
       out_given = true;
     } else {
       error.message = "unknown option '" + arg + "'";

@@ -4,16 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include "robot/nav_metrics.hpp"
+#include "robot/sensing/motion_delta.hpp"
 #include "world/world.hpp"
 
 namespace rfbsim::report {
 
 namespace {
-
-double wrap_angle(double angle) { return std::remainder(angle, 2.0 * std::numbers::pi); }
 
 // A world that holds just what NavMetrics reads, filled from one sample: the robot, the people and the
 // avatar, each with its position, velocity and body radius.
@@ -103,7 +101,7 @@ std::optional<RobotMetrics> robot_metrics(const SampledSession& session) {
     nav.observe(w, session.sample_interval);
     social.observe(w, session.sample_interval);
     speed_sum += std::hypot(sample.robot->vx, sample.robot->vy);
-    if (i > 0) out.heading_change += std::abs(wrap_angle(sample.robot->yaw - session.samples[i - 1].robot->yaw));
+    if (i > 0) out.heading_change += std::abs(sim::normalize_angle(sample.robot->yaw - session.samples[i - 1].robot->yaw));
   }
   const sim::NavSummary s = nav.summary();
   const double n = static_cast<double>(session.samples.size());

@@ -14,7 +14,7 @@ using rfbsim::manager::parse_manager_args;
 using rfbsim::manager::session_kind_name;
 using rfbsim::manager::SessionKind;
 using rfbsim::manager::validate_config;
-using rfbsim::manager::test::ScratchDir;
+using rfbsim::test::ScratchDir;
 
 using Strings = std::vector<std::string>;
 using std::chrono::seconds;

@@ -15,7 +15,7 @@ using rfbsim::manager::Session;
 using rfbsim::manager::SessionIndex;
 using rfbsim::manager::SessionState;
 using rfbsim::manager::WallTime;
-using rfbsim::manager::test::ScratchDir;
+using rfbsim::test::ScratchDir;
 
 namespace {
 

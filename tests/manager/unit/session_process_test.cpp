@@ -29,7 +29,7 @@ using rfbsim::manager::signal_process_group;
 using rfbsim::manager::spawn_session_process;
 using rfbsim::manager::SpawnedProcess;
 using rfbsim::manager::SpawnSpec;
-using rfbsim::manager::test::ScratchDir;
+using rfbsim::test::ScratchDir;
 
 namespace {
 
