@@ -122,6 +122,11 @@ const std::map<std::string, Setting>& settings() {
          c.session_args = v;
          return "";
        }}},
+      {"codec", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.front() != "auto" && v.front() != "jpeg" && v.front() != "h264") return "expected auto, jpeg or h264";
+         c.codec = v.front();
+         return "";
+       }}},
       {"max_sessions", {false, integer(&ManagerConfig::max_sessions, 1, 10000)}},
       {"max_duration_s", {false, seconds(&ManagerConfig::max_duration, 1)}},
       {"idle_timeout_s", {false, seconds(&ManagerConfig::idle_timeout, 1)}},
@@ -223,7 +228,8 @@ const char* session_kind_name(SessionKind kind) { return kind == SessionKind::kS
 std::string manager_usage() {
   return "usage: sim_manager [--config FILE] [--listen-address ADDR] [--port N] [--tls-certificate PEM]\n"
          "                   [--tls-private-key PEM] [--session-command PROGRAM] [--session-kind sim_rfb|rfb]\n"
-         "                   [--session-arg ARG]... [--max-sessions N] [--max-duration-s S] [--idle-timeout-s S]\n"
+         "                   [--session-arg ARG]... [--codec auto|jpeg|h264] [--max-sessions N]\n"
+         "                   [--max-duration-s S] [--idle-timeout-s S]\n"
          "                   [--data-dir DIR] [--scenarios A,B] [--frame-origins O1,O2] [--admin-token T]\n"
          "                   [--link-secret S] [--allow-repeat true|false] [--host-id ID] [--web-root DIR]\n"
          "                   [--public-url ORIGIN]\n"
@@ -236,6 +242,9 @@ std::string manager_usage() {
          "  --session-kind K        sim_rfb (default), or rfb: any program that serves raw RFB on the port\n"
          "                          given as {port} in its --session-arg list\n"
          "  --session-arg A         one more argument for the session program (repeat as needed)\n"
+         "  --codec C               sim_rfb's picture encoding: auto (default: Tight JPEG, H.264 for a browser\n"
+         "                          that offers it once its link needs it), jpeg, or h264 (H.264 for every\n"
+         "                          browser that offers it; noVNC 1.6+ needs https or localhost for it)\n"
          "  --max-sessions N        live sessions at once (default 4)\n"
          "  --max-duration-s S      a session ends S seconds after it started (default 300)\n"
          "  --idle-timeout-s S      a session ends after S seconds with no browser connected (default 60)\n"

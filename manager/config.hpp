@@ -12,7 +12,7 @@ namespace rfbsim::manager {
 
 /// How the manager talks to the program it starts for each session.
 enum class SessionKind {
-  kSimRfb,  ///< sim_rfb: the manager adds --port 0 --rfb-only --ready-fd 3 and the link's parameters
+  kSimRfb,  ///< sim_rfb: the manager adds --port 0 --rfb-only --ready-fd 3, --codec and the link's parameters
   kRfb,     ///< any program serving raw RFB on a loopback port: args may use {port} {scenario} {seed} {uid}
             ///< {data_dir}; ready once the port accepts a connection
 };
@@ -44,6 +44,9 @@ struct ManagerConfig {
   std::string session_command = "sim_rfb";   ///< program path; "sim_rfb" = the one built or installed
   SessionKind session_kind = SessionKind::kSimRfb;
   std::vector<std::string> session_args;     ///< extra arguments (kRfb: the whole argument template)
+  /// kSimRfb: the picture encoding sim_rfb is started with (--codec): "auto" (Tight JPEG, H.264 for a browser
+  /// that offers it once its link needs it), "jpeg" or "h264".
+  std::string codec = "auto";
   int max_sessions = 4;                      ///< live sessions at once; the next participant is told to wait
   std::chrono::seconds max_duration{300};    ///< a session is ended this long after it started (SEAN-EP: 5 min)
   std::chrono::seconds idle_timeout{60};     ///< ended after this long with no browser connected

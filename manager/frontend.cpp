@@ -220,7 +220,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
                                    ",\"capacity\":" + std::to_string(config_.max_sessions) + "}");
         return;
       case RouteKind::kMetrics:
-        respond(con, 200, metrics_.render(supervisor_.counts_by_state(), config_.max_sessions, relay_counts()),
+        respond(con, 200,
+                metrics_.render(supervisor_.counts_by_state(), config_.max_sessions, relay_counts(), session_streams()),
                 "text/plain; version=0.0.4; charset=utf-8");
         return;
       case RouteKind::kAdminPage: handle_admin_page(con, route); return;
@@ -474,6 +475,15 @@ class FrontendImpl final : public Frontend, public SessionListener {
     relays_.erase(it);
     relay->browser_gone();
     if (relay->kind() == RelayKind::kParticipant) supervisor_.client_disconnected(relay->session_id());
+  }
+
+  // Live sessions' streams as sim_rfb last reported them, for the per-session gauges.
+  std::vector<SessionStream> session_streams() {
+    std::vector<SessionStream> streams;
+    for (Session* session : supervisor_.table().all()) {
+      if (session->stream) streams.push_back({session->id, *session->stream});
+    }
+    return streams;
   }
 
   RelayCounts relay_counts() const {

@@ -60,6 +60,8 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
   // Session data goes to the session's folder; the codes are shown in the picture when the task ends. The
   // relay names each browser's address in a PROXY line, which sim_rfb records hashed.
   args.insert(args.end(), {"--proxy-protocol", "--data-dir", context.data_dir, "--uid", request.uid});
+  // The picture encoding, always named, so that the session's command line says what it ran with.
+  args.insert(args.end(), {"--codec", config.codec});
   if (!request.code_success.empty()) args.insert(args.end(), {"--code-success", request.code_success});
   if (!request.code_timeout.empty()) args.insert(args.end(), {"--code-timeout", request.code_timeout});
   args.insert(args.end(), config.session_args.begin(), config.session_args.end());

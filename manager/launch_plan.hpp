@@ -21,8 +21,8 @@ struct LaunchContext {
 
 /// Arguments after the program name.
 ///  - kSimRfb: --port 0 --bind 127.0.0.1 --rfb-only --ready-fd 3 --scenario S --seed N, one flag per
-///    override, --proxy-protocol --data-dir DIR --uid U, --code-success T1 and --code-timeout T2 when the link has them,
-///    then config.session_args.
+///    override, --proxy-protocol --data-dir DIR --uid U --codec C (config.codec), --code-success T1 and
+///    --code-timeout T2 when the link has them, then config.session_args.
 ///  - kRfb: config.session_args with {port}, {scenario}, {seed}, {uid}, {data_dir}, {t1} and {t2} replaced.
 std::vector<std::string> session_arguments(const ManagerConfig& config, const StartRequest& request,
                                            const LaunchContext& context);

@@ -23,6 +23,24 @@ void header(std::string& out, const char* name, const char* type, const char* he
   out += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n";
 }
 
+// A label value as the exposition format quotes it: backslash, double quote and newline escaped. The values
+// used are plain already (state names, numbers, codec names the stream parser checked); this keeps any other
+// from breaking the text.
+std::string label_value(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '\\' || c == '"') {
+      out += '\\';
+      out += c;
+    } else if (c == '\n') {
+      out += "\\n";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 const char* rejection_name(Rejection reason) {
@@ -56,7 +74,7 @@ std::uint64_t Metrics::rejections(Rejection reason) const {
 }
 
 std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions_by_state, int capacity,
-                            RelayCounts relays) const {
+                            RelayCounts relays, const std::vector<SessionStream>& streams) const {
   std::string out;
   header(out, "rfbsim_sessions", "gauge", "Sessions by state (live states now; ended states in the whole index).");
   for (const SessionState state : kAllStates) {
@@ -96,6 +114,27 @@ std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions
   for (const Rejection reason : kAllRejections) {
     out += std::string("rfbsim_rejections_total{reason=\"") + rejection_name(reason) + "\"} " +
            std::to_string(rejections(reason)) + "\n";
+  }
+  // Each watched session's stream, as sim_rfb last reported it (about every second).
+  const auto session_label = [](const SessionStream& s) { return "session=\"" + std::to_string(s.session_id) + "\""; };
+  header(out, "rfbsim_session_rtt_ms", "gauge",
+         "The participant's latest round trip through the session's picture stream, ms (fences; where measured).");
+  for (const SessionStream& s : streams) {
+    if (s.report.clients > 0 && s.report.rtt_ms) {
+      out += "rfbsim_session_rtt_ms{" + session_label(s) + "} " + number(*s.report.rtt_ms) + "\n";
+    }
+  }
+  header(out, "rfbsim_session_fps", "gauge", "Picture updates per second to the session's participant, lately.");
+  for (const SessionStream& s : streams) {
+    if (s.report.clients > 0 && s.report.fps) {
+      out += "rfbsim_session_fps{" + session_label(s) + "} " + number(*s.report.fps) + "\n";
+    }
+  }
+  header(out, "rfbsim_session_codec_info", "gauge", "The encoding of the session's picture stream (tight or h264): 1.");
+  for (const SessionStream& s : streams) {
+    if (s.report.clients > 0 && !s.report.codec.empty()) {
+      out += "rfbsim_session_codec_info{" + session_label(s) + ",codec=\"" + label_value(s.report.codec) + "\"} 1\n";
+    }
   }
   return out;
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "session.hpp"
+#include "stream_report.hpp"
 
 namespace rfbsim::manager {
 
@@ -41,6 +42,13 @@ struct RelayCounts {
   int watch = 0;
 };
 
+/// One live session's stream for the per-session gauges. The label is the session's index id: a number, never
+/// the uid (a participant's identity) or the token (the key to the session), which /metrics must not show.
+struct SessionStream {
+  std::int64_t session_id = 0;
+  StreamReport report;  ///< sim_rfb's latest; sessions nobody watches (clients 0) get no series
+};
+
 /// Counters since the manager started; the session gauges are read from the table when rendered.
 class Metrics {
  public:
@@ -60,9 +68,10 @@ class Metrics {
   [[nodiscard]] std::uint64_t bytes_to_client() const { return bytes_to_client_; }
 
   /// The exposition text. `sessions_by_state`: live sessions by state now, and ended ones by state over
-  /// the whole index; `relays`: WebSocket relays open now.
+  /// the whole index; `relays`: WebSocket relays open now; `streams`: live sessions' streams, for
+  /// rfbsim_session_rtt_ms, rfbsim_session_fps and rfbsim_session_codec_info (each series only where known).
   [[nodiscard]] std::string render(const std::map<SessionState, std::int64_t>& sessions_by_state, int capacity,
-                                   RelayCounts relays) const;
+                                   RelayCounts relays, const std::vector<SessionStream>& streams = {}) const;
 
  private:
   std::uint64_t starts_ = 0;

@@ -3,9 +3,9 @@
 // relay (a researcher's view) passes the browser's bytes through an RfbInputFilter first, so that a watcher
 // sees the session but cannot steer it.
 //
-// Flow control keeps a slow browser from growing the manager's memory: while more than kMaxBuffered bytes
-// wait in the WebSocket's send buffer, the relay stops reading from the session, so TCP pushes back and
-// the session's own flow control gives that participant fewer, current frames. Input from the browser
+// Flow control keeps the relay out of the session's picture of the link: the relay reads from the session
+// only while the WebSocket's send buffer has room for a whole chunk within kMaxBuffered, so TCP pushes back at
+// once and the session's own flow control gives that participant fewer, current frames. Input from the browser
 // is small (keys); more than kMaxPending unsent bytes of it means a broken client, and it is closed.
 //
 // Templated on the websocketpp server type (plain or TLS); everything runs on the I/O thread.
@@ -34,7 +34,14 @@ namespace rfbsim::manager {
 template <typename Server>
 class Relay : public std::enable_shared_from_this<Relay<Server>> {
  public:
-  static constexpr std::size_t kMaxBuffered = 1 << 20;
+  /// At most this many bytes wait in the WebSocket's send buffer toward the browser. Small on purpose: sim_rfb's
+  /// congestion control measures the whole path with fences (a fence comes back only after every byte before
+  /// it reached the browser), and every byte queued here is queueing delay it sees as a longer round trip and
+  /// then has to drain. A deep buffer (it was 1 MiB) hid the participant's link behind a second or more of
+  /// backlog at a few Mbit/s; 64 KiB is about 50 ms at 10 Mbit/s, and still a few updates' worth on a fast link.
+  static constexpr std::size_t kMaxBuffered = 64 * 1024;
+  /// Bytes read from the session at once: a quarter of kMaxBuffered, so that one chunk never overshoots it.
+  static constexpr std::size_t kReadChunk = kMaxBuffered / 4;
   static constexpr std::size_t kMaxPending = 1 << 20;
   static constexpr auto kDrainPoll = std::chrono::milliseconds(5);
 
@@ -158,12 +165,12 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     });
   }
 
-  // Reads the next chunk once the browser has taken most of what was sent.
+  // Reads the next chunk once it fits within kMaxBuffered beside what the browser has not taken yet.
   void read_when_drained() {
     websocketpp::lib::error_code ec;
     auto connection = server_.get_con_from_hdl(browser_, ec);
     if (ec || closed_) return;
-    if (connection->get_buffered_amount() <= kMaxBuffered) {
+    if (connection->get_buffered_amount() + kReadChunk <= kMaxBuffered) {
       read_upstream();
       return;
     }
@@ -201,7 +208,7 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   UpstreamLost on_upstream_lost_;
   boost::asio::ip::tcp::socket upstream_;
   boost::asio::steady_timer drain_timer_;
-  std::array<char, 64 * 1024> buffer_{};
+  std::array<char, kReadChunk> buffer_{};
   std::deque<std::string> pending_;
   std::string proxy_line_;
   std::size_t pending_bytes_ = 0;

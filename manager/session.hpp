@@ -16,6 +16,8 @@
 #include <string>
 #include <string_view>
 
+#include "stream_report.hpp"
+
 namespace rfbsim::manager {
 
 enum class SessionState {
@@ -75,6 +77,9 @@ struct Session {
   WallTime created{};           ///< /start accepted
   std::optional<WallTime> ready_at;  ///< the program reported ready
   std::optional<WallTime> ended_at;  ///< the process was gone
+  /// The participant's stream as sim_rfb last reported it while someone watched; unset before the first report,
+  /// when nobody watches, and for sessions read from the index (it is not stored there).
+  std::optional<StreamReport> stream;
 };
 
 /// The state a session has, or while ending the one it will get: what a browser or page is told.

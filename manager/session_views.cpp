@@ -47,6 +47,18 @@ std::string session_json(const Session& s, bool include_token) {
                      ",\"data_path\":\"" + json_escape(s.data_path) + "\",\"outcome\":" +
                      (s.outcome.empty() ? std::string("null") : "\"" + json_escape(s.outcome) + "\"") + ",\"params\":" +
                      (s.params_json.empty() ? "{}" : s.params_json);
+  // The stream as sim_rfb last told it; null for what it did not say and when nobody watches.
+  const auto decimal = [](const std::optional<double>& value) {
+    if (!value) return std::string("null");
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", *value);
+    return std::string(text);
+  };
+  const bool watched = s.stream && s.stream->clients > 0;
+  json += std::string(",\"codec\":") +
+          (watched && !s.stream->codec.empty() ? "\"" + json_escape(s.stream->codec) + "\"" : std::string("null")) +
+          ",\"rtt_ms\":" + decimal(watched ? s.stream->rtt_ms : std::nullopt) +
+          ",\"fps\":" + decimal(watched ? s.stream->fps : std::nullopt);
   if (include_token) json += ",\"token\":\"" + s.token + "\"";
   return json + "}";
 }

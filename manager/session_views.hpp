@@ -25,8 +25,10 @@ CloseNotice close_notice(SessionState state);
 /// `survey_origins` (a watching researcher's page gets none).
 std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins);
 
-/// One session for the admin API: id, uid, scenario, seed, state, detail, exit status, times, data path and
-/// the link's parameters; the token only when `include_token` (live sessions, which a researcher may watch).
+/// One session for the admin API: id, uid, scenario, seed, state, detail, exit status, times, data path, the
+/// link's parameters, and the participant's stream: "codec" ("tight", "h264"), "rtt_ms" (1 decimal) and "fps"
+/// (1 decimal), each null when unknown or nobody watches; the token only when `include_token` (live sessions,
+/// which a researcher may watch).
 std::string session_json(const Session& session, bool include_token);
 
 }  // namespace rfbsim::manager

@@ -32,6 +32,10 @@ namespace asio = boost::asio;
 // How often a kRfb session's port is tried until it takes a connection.
 constexpr auto kPortPollInterval = std::chrono::milliseconds(20);
 
+// The longest line the program's pipe may carry ("ready PORT", "outcome ...", "stream ..." lines are all far
+// shorter): more without a newline is nonsense, and the pipe is not listened to any more.
+constexpr std::size_t kMaxPipeLine = 256;
+
 std::uint64_t cpu_limit_seconds(const ManagerConfig& config) {
   if (config.limits.cpu_time_factor <= 0) return 0;
   const double seconds = static_cast<double>(config.max_duration.count()) * config.limits.cpu_time_factor +
@@ -72,8 +76,9 @@ struct Supervisor::Runtime {
   asio::steady_timer expiry, idle, stop, start_deadline, poll;
   asio::posix::stream_descriptor ready_pipe;
   asio::ip::tcp::socket probe;  // kRfb: tries the port until it answers
-  std::array<char, 64> buffer{};
+  std::array<char, 256> buffer{};
   std::string ready_text;
+  bool bad_stream_logged = false;  // a bad stream line is logged once per session, not every second
   int clients = 0;
   SteadyClock::time_point started;
 };
@@ -280,7 +285,7 @@ void Supervisor::watch_ready_pipe(Session& session) {
       r.ready_text.erase(0, newline + 1);
       if (!take_pipe_line(*s, line)) return;
     }
-    if (r.ready_text.size() > 64) {
+    if (r.ready_text.size() > kMaxPipeLine) {
       if (s->state == SessionState::kStarting) {
         begin_end(*s, SessionState::kFailed, "the program's ready line is not 'ready PORT'");
       }
@@ -299,6 +304,19 @@ bool Supervisor::take_pipe_line(Session& session, const std::string& line) {
       return false;
     }
     mark_ready(session, port);
+    return true;
+  }
+  // The participant's stream, about once a second while someone watches: the latest is kept for the admin page,
+  // the API and the metrics (not the index: it is a reading, not the session's record).
+  if (is_stream_line(line)) {
+    StreamParse parsed = parse_stream_line(line);
+    if (parsed.report) {
+      session.stream = parsed.report->clients > 0 ? parsed.report : std::nullopt;
+    } else if (!runtime(session.id).bad_stream_logged) {
+      runtime(session.id).bad_stream_logged = true;
+      log_session(session, "ignored a stream line (" + parsed.error + "), and will not log another: '" +
+                               line.substr(0, 96) + "'");
+    }
     return true;
   }
   if ((line == "outcome completed" || line == "outcome timeout") && session.outcome.empty()) {

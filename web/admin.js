@@ -62,6 +62,12 @@ function formatDuration(ms) {
 
 const millisBetween = (fromIso, to) => to - new Date(fromIso).getTime();
 
+// The stream's values from the API ("codec", "rtt_ms", "fps"; null when unknown or nobody watches), '\u2013' for
+// unknown.
+const DASH = '\u2013';
+const formatCodec = (codec) => (typeof codec === 'string' && codec !== '' ? codec : DASH);
+const formatNumber = (value, unit) => (Number.isFinite(value) ? `${value.toFixed(value < 10 ? 1 : 0)}${unit}` : DASH);
+
 // ---------------------------------------------------------------------------------------------------------------
 // Tables. Rows are kept per session id and updated in place, so a refresh never takes the keyboard focus away
 // from a link or button, and screen readers are not told about cells that did not change.
@@ -132,12 +138,13 @@ function syncRows(tbody, sessions, make, update) {
   });
 }
 
-// Live sessions: id, participant, scenario, state, started, age, data folder, Watch and End. Watch opens the
+// Live sessions: id, participant, scenario, state, started, age, codec, round trip, frame rate, data folder, Watch
+// and End. Watch opens the
 // participant's page under /admin/watch/, where sim_manager relays it view-only: the researcher's keys and clicks
 // never reach the session, and watching does not keep an idle session alive.
 function makeLiveRow(session) {
-  const row = makeRow(session.id, ['num', '', '', '', 'time', 'num', 'path', 'actions']);
-  const actions = row.cells[7];
+  const row = makeRow(session.id, ['num', '', '', '', 'time', 'num', '', 'num', 'num', 'path', 'actions']);
+  const actions = row.cells[10];
   const watch = document.createElement('a');
   watch.target = '_blank';
   watch.rel = 'noopener noreferrer';
@@ -158,8 +165,11 @@ function updateLiveRow(row, session, now) {
   setState(c[3], session.state, session.state === 'ending' && session.detail ? `(${session.detail})` : '');
   setText(c[4], formatTime(session.created_at));
   setText(c[5], formatDuration(millisBetween(session.created_at, now)));
-  setText(c[6], session.data_path);
-  const [watch, end] = c[7].children;
+  setText(c[6], formatCodec(session.codec));
+  setText(c[7], formatNumber(session.rtt_ms, ' ms'));
+  setText(c[8], formatNumber(session.fps, ''));
+  setText(c[9], session.data_path);
+  const [watch, end] = c[10].children;
   const href = session.token ? `/admin/watch/${encodeURIComponent(session.token)}/` : '';
   if (watch.getAttribute('href') !== href) {
     watch.setAttribute('href', href);

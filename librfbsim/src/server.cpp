@@ -26,21 +26,26 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <thread>
 #include <utility>
 
 #include "call_watchdog.hpp"
+#include "client_state.hpp"
 #include "frame_mailbox.hpp"
 #include "held_keys.hpp"
 #include "http_request.hpp"
 #include "http_service.hpp"
 #include "listener.hpp"
 #include "proxy_header.hpp"
+#include "rfb_extension.hpp"
 #include "rfbsim/tile_damage.hpp"
 
 namespace rfbsim {
+
+using detail::ClientState;
 
 namespace {
 
@@ -114,6 +119,7 @@ ServerOptions validated(ServerOptions o) {
   }
   if (o.jpeg_quality < 0 || o.jpeg_quality > 100) throw std::runtime_error("jpeg_quality must be 0..100");
   if (o.max_clients < 1) throw std::runtime_error("max_clients must be at least 1");
+  if (o.frame_rate < 1 || o.frame_rate > 240) throw std::runtime_error("frame_rate must be 1..240");
   if (o.read_timeout.count() < 1 || o.write_timeout.count() < 1) {
     throw std::runtime_error("read_timeout and write_timeout must be at least 1 ms");
   }
@@ -129,15 +135,6 @@ ServerOptions validated(ServerOptions o) {
 }
 
 }  // namespace
-
-// Per-client bookkeeping, owned through rfbClientRec::clientData.
-struct ClientState {
-  ClientInfo info;
-  int guard_fd = -1;  // our dup of the client's socket, for the watchdog (libvncserver may close its own)
-  std::optional<Clock::time_point> backed_up_since;  // output above kMaxUnsentBytes since then
-  Clock::time_point update_started{};
-  int bytes_before_update = 0;
-};
 
 // A connection accepted but not yet known to be HTTP, WebSocket or raw RFB.
 struct PendingConnection {
@@ -171,6 +168,8 @@ struct Server::Impl {
   static void on_pointer(int mask, int x, int y, rfbClientPtr cl);
   static void on_update_start(rfbClientPtr cl);
   static void on_update_done(rfbClientPtr cl, int result);
+  static void on_update_request(rfbClientPtr cl, rfbFramebufferUpdateRequestMsg* request);
+  void publish_streams(Clock::time_point now);
 
   ServerOptions options;
   // Whether plain HTTP has anything to get here (a web root or a json route). Without it every new
@@ -191,6 +190,10 @@ struct Server::Impl {
   int adopting_guard_fd = -1;             // handed from adopt_rfb to on_new_client
   std::string adopting_address;           // handed from adopt_rfb to on_new_client; "" = the socket's peer
   bool any_backed_up = false;             // some client's output is above kMaxUnsentBytes
+  detail::StreamerConfig streamer_config;  // what each client's ClientStreamer starts from
+  Clock::time_point streams_published{};  // when `streams` was last refreshed
+  mutable std::mutex streams_mutex;        // guards `streams` (read from any thread)
+  std::vector<ClientStreamStatus> streams;
   int next_client_id = 1;
 
   std::atomic<bool> stopping{false};
@@ -214,6 +217,14 @@ Server::Impl::Impl(ServerOptions o)
   // too, so both channels stay quiet unless RFBSIM_VNC_LOG is set; our own failures are reported below.
   rfbLog = vnc_log;
   rfbErr = vnc_log;
+  detail::register_streaming_extension();
+  streamer_config.width = options.width;
+  streamer_config.height = options.height;
+  streamer_config.frame_rate = options.frame_rate;
+  streamer_config.jpeg_quality = options.jpeg_quality;
+  streamer_config.subsampling = turbo_subsampling_index(options.subsampling);
+  streamer_config.adaptive_quality = options.adaptive_quality && options.jpeg_quality > 0;
+  streamer_config.codec = options.codec;
 
   listener = detail::open_listener(options.bind_address, options.port);
   wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -344,18 +355,31 @@ void Server::Impl::serve_clients(const std::vector<pollfd>& polled) {
       rfbProcessClientMessage(cl);
     }
     watchdog.disarm();
+    // What the messages negotiated (Fence, ContinuousUpdates) is announced once, after them.
+    if (cl->sock != RFB_INVALID_SOCKET && cl->clientData != nullptr) {
+      watchdog.arm(state->guard_fd, Clock::now() + options.write_timeout);
+      static_cast<ClientState*>(cl->clientData)->streamer.after_messages(cl);
+      watchdog.disarm();
+    }
   }
 
-  // 2. Send updates to the clients that asked for one and can take it.
+  // 2. Send updates to the clients that are due one (asked for, or pushed while their link has room).
   const auto now = Clock::now();
   any_backed_up = false;
   for (rfbClientPtr cl = screen->clientHead; cl != nullptr; cl = cl->next) {
     if (cl->sock == RFB_INVALID_SOCKET || !may_send_update(cl, now)) continue;
-    const auto* state = static_cast<ClientState*>(cl->clientData);
+    auto* state = static_cast<ClientState*>(cl->clientData);
     watchdog.arm(state->guard_fd, now + options.write_timeout);
-    rfbUpdateClient(cl);
+    const auto sent = state->streamer.serve(cl, now, framebuffer.data());
     watchdog.disarm();
+    // Tight updates are counted by the update hooks; H.264 ones are written by the streamer itself.
+    if (sent.bytes > 0) {
+      bytes_sent += sent.bytes;
+      encode_ns += static_cast<std::uint64_t>(sent.encode.count());
+      ++updates_sent;
+    }
   }
+  publish_streams(now);
 
   // 3. Forget the clients that left or were dropped above (this runs on_client_gone).
   for (rfbClientPtr cl = screen->clientHead; cl != nullptr;) {
@@ -514,6 +538,25 @@ void Server::Impl::apply_newest_frame() {
   }
   tiles_changed += static_cast<std::uint64_t>(damage.changed_count());
   ++frames_applied;
+  const auto now = Clock::now();
+  for (rfbClientPtr cl = screen->clientHead; cl != nullptr; cl = cl->next) {
+    if (auto* state = static_cast<ClientState*>(cl->clientData)) state->streamer.frame_changed(now);
+  }
+}
+
+// The status snapshot that client_streams() hands out, refreshed a few times a second.
+void Server::Impl::publish_streams(Clock::time_point now) {
+  constexpr auto kEvery = std::chrono::milliseconds(100);
+  if (now - streams_published < kEvery) return;
+  streams_published = now;
+  std::vector<ClientStreamStatus> fresh;
+  for (rfbClientPtr cl = screen->clientHead; cl != nullptr; cl = cl->next) {
+    if (const auto* state = static_cast<const ClientState*>(cl->clientData)) {
+      fresh.push_back(state->streamer.status(state->info.id, now));
+    }
+  }
+  const std::lock_guard lock(streams_mutex);
+  streams = std::move(fresh);
 }
 
 rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
@@ -525,12 +568,13 @@ rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
                  self.options.max_clients);
     return RFB_CLIENT_REFUSE;
   }
-  auto* state = new ClientState;
+  auto* state = new ClientState(self.streamer_config);
   state->info.id = self.next_client_id++;
   state->info.address = self.adopting_address.empty() ? peer_address(cl->sock) : self.adopting_address;
   state->info.websocket = cl->wsctx != nullptr;
   state->guard_fd = std::exchange(self.adopting_guard_fd, -1);
   cl->clientData = state;
+  cl->clientFramebufferUpdateRequestHook = on_update_request;
   cl->viewOnly = self.options.view_only ? TRUE : FALSE;
   ++self.clients;
   if (self.options.on_connect) self.options.on_connect(state->info);
@@ -590,29 +634,39 @@ void Server::Impl::on_pointer(int mask, int x, int y, rfbClientPtr cl) {
 }
 
 void Server::Impl::on_update_start(rfbClientPtr cl) {
-  Impl& self = of(cl);
   auto* state = static_cast<ClientState*>(cl->clientData);
   if (state == nullptr) return;
   state->update_started = Clock::now();
   state->bytes_before_update = rfbStatGetSentBytes(cl);
-  // Impose the server's JPEG quality and subsampling on Tight clients, whatever level they asked for.
-  if (self.options.jpeg_quality > 0) {
-    cl->turboQualityLevel = self.options.jpeg_quality;
-    cl->turboSubsampLevel = turbo_subsampling_index(self.options.subsampling);
-    cl->tightQualityLevel = std::min(9, self.options.jpeg_quality / 10);
+  // Impose the server's JPEG quality and subsampling on Tight clients, whatever level they asked for;
+  // the client's streamer lowers it while its link cannot carry the frame rate.
+  if (const auto level = state->streamer.tight_quality()) {
+    cl->turboQualityLevel = level->jpeg_quality;
+    cl->turboSubsampLevel = level->subsampling;
+    cl->tightQualityLevel = std::min(9, level->jpeg_quality / 10);
   }
+}
+
+void Server::Impl::on_update_request(rfbClientPtr cl, rfbFramebufferUpdateRequestMsg* request) {
+  // A full (non-incremental) request means the client lost its picture: H.264 restarts with an IDR.
+  auto* state = static_cast<ClientState*>(cl->clientData);
+  if (state == nullptr) return;
+  ++state->streamer.protocol().update_requests;
+  if (request->incremental == 0) state->streamer.protocol().full_update_requested = true;
 }
 
 void Server::Impl::on_update_done(rfbClientPtr cl, int /*result*/) {
   Impl& self = of(cl);
-  const auto* state = static_cast<ClientState*>(cl->clientData);
+  auto* state = static_cast<ClientState*>(cl->clientData);
   if (state == nullptr) return;
   // libvncserver's byte counter is an int that wraps after 2 GiB: subtract as unsigned 32-bit.
   const std::uint32_t sent = static_cast<std::uint32_t>(rfbStatGetSentBytes(cl)) -
                              static_cast<std::uint32_t>(state->bytes_before_update);
   // The hook also runs when libvncserver found nothing to send; that is no update.
   if (sent == 0) return;
-  const auto elapsed = Clock::now() - state->update_started;
+  const auto now = Clock::now();
+  const auto elapsed = now - state->update_started;
+  state->streamer.tight_update_written(now, sent);
   self.encode_ns += static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(elapsed).count());
   self.bytes_sent += sent;
   ++self.updates_sent;
@@ -659,6 +713,11 @@ ServerStats Server::stats() const {
   s.clients = impl_->clients.load();
   s.stalled_clients_dropped = impl_->watchdog.fired() + impl_->backed_up_drops.load();
   return s;
+}
+
+std::vector<ClientStreamStatus> Server::client_streams() const {
+  const std::lock_guard lock(impl_->streams_mutex);
+  return impl_->streams;
 }
 
 const ServerOptions& Server::options() const { return impl_->options; }

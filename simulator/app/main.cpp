@@ -4,6 +4,7 @@
 // The main thread is the simulation thread: it owns the GL context, steps the world at a fixed rate,
 // and renders at the frame rate only while someone is watching. librfbsim's own thread does the network.
 #include <fcntl.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -25,6 +26,7 @@
 #include "app/options.hpp"
 #include "app/session_setup.hpp"
 #include "app/simulation.hpp"
+#include "app/stream_status.hpp"
 #include "app/study_session.hpp"
 #include "record/digest.hpp"
 #include "record/session_writer.hpp"
@@ -88,6 +90,55 @@ void report_ready(int fd, int port) {
     throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": cannot write the ready line (" + error + ")");
   }
 }
+
+// The viewers' stream, told to the parent (sim_manager) on the ready pipe: a "stream ..." line about every second
+// while someone watches, and "stream clients=0" once when the last viewer leaves (app/stream_status.hpp). A
+// line is skipped rather than waited for when the pipe is full (a parent that stopped reading): the simulation
+// thread never blocks on it. A parent that is gone ends the reports, with one word in the log.
+class StreamReporter {
+ public:
+  static constexpr std::chrono::seconds kInterval{1};
+
+  explicit StreamReporter(int fd) : fd_(fd) {}
+
+  void update(std::chrono::steady_clock::time_point now, int clients, const rfbsim::Server& server) {
+    if (failed_) return;
+    if (clients == 0) {
+      if (reported_) write(rfbsim::sim::stream_line({}));  // the parent stops showing the last report
+      watched_ = reported_ = false;
+      return;
+    }
+    // The first report a second after the first viewer came, once there is a frame rate to tell.
+    if (!watched_) next_ = now + kInterval;
+    watched_ = true;
+    if (now < next_) return;
+    const std::vector<rfbsim::ClientStreamStatus> streams = server.client_streams();
+    if (streams.empty()) return;  // the network thread has not seen the viewer yet: try again next loop
+    write(rfbsim::sim::stream_line(streams));
+    reported_ = true;
+    next_ = now + kInterval;
+  }
+
+ private:
+  void write(const std::string& line) {
+    pollfd pfd{fd_, POLLOUT, 0};
+    if (::poll(&pfd, 1, 0) != 1 || (pfd.revents & POLLOUT) == 0) {
+      if ((pfd.revents & (POLLERR | POLLHUP)) == 0) return;  // full: this one is skipped, the next may fit
+    }
+    // Under PIPE_BUF bytes: written whole or not at all.
+    const std::string error = write_line(fd_, line);
+    if (error.empty()) return;
+    failed_ = true;
+    std::fprintf(stderr, "[sim_rfb] cannot report the stream to the parent: %s; no more stream lines\n",
+                 error.c_str());
+  }
+
+  int fd_;
+  bool watched_ = false;   // someone watched at the last update
+  bool reported_ = false;  // a stream line was written since the last viewer came
+  bool failed_ = false;
+  std::chrono::steady_clock::time_point next_{};
+};
 
 // The page: --web-root if given, else the one built beside this binary, else the installed one.
 std::string find_web_root(const std::string& requested) {
@@ -201,6 +252,10 @@ int run(const rfbsim::sim::SimOptions& options) {
   server_options.width = options.width;
   server_options.height = options.height;
   server_options.jpeg_quality = options.jpeg_quality;
+  server_options.codec = options.codec == "h264"   ? rfbsim::Codec::kH264
+                         : options.codec == "jpeg" ? rfbsim::Codec::kJpeg
+                                                   : rfbsim::Codec::kAuto;
+  server_options.frame_rate = options.fps;  // H.264 timing: the rate frames are submitted at while watched
   server_options.max_clients = options.max_clients;
   server_options.desktop_name = "rfbsim";
   server_options.proxy_protocol = options.proxy_protocol;
@@ -229,6 +284,8 @@ int run(const rfbsim::sim::SimOptions& options) {
   gl_options.platform = options.egl_platform;
   rfbsim::OffscreenGL gl(gl_options);
   std::fprintf(stderr, "[sim_rfb] rendering with %s\n", gl.renderer().c_str());
+  std::fprintf(stderr, "[sim_rfb] picture encoding %s, %d frames per second while watched\n", options.codec.c_str(),
+               options.fps);
 
   sim::FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / options.tick_hz));
   const auto frame_interval = std::chrono::nanoseconds(1'000'000'000LL / options.fps);
@@ -253,6 +310,8 @@ int run(const rfbsim::sim::SimOptions& options) {
   std::printf("sim_rfb ready: %s\n", server.url().c_str());
   std::fflush(stdout);
 
+  std::optional<StreamReporter> stream_reporter;
+  if (options.ready_fd) stream_reporter.emplace(*options.ready_fd);
   auto last = Clock::now();
   auto next_frame = last;
   bool outcome_reported = false;
@@ -300,8 +359,10 @@ int run(const rfbsim::sim::SimOptions& options) {
     if (writer) writer->flush_if_due();
     const int clients = server.client_count();
     if (ticks > 0 && !options.rfb_only) {
-      status.publish(sim::status_json(simulation.world(), clients, frames_rendered));
+      status.publish(
+          sim::status_json(simulation.world(), clients, frames_rendered, sim::streams_json(server.client_streams())));
     }
+    if (stream_reporter) stream_reporter->update(now, clients, server);
 
     // Render only for a viewer, at the frame rate.
     if (clients == 0) {

@@ -37,7 +37,8 @@ std::string sim_usage() {
   return "usage: sim_rfb [--port N] [--bind ADDR] [--width W] [--height H] [--fps F] [--seed S]\n"
          "               [--scenario NAME|PATH] [--avatar-start P] [--avatar-goal P] [--robot-start P]\n"
          "               [--robot-goal P] [--crowd N]\n"
-         "               [--quality Q] [--max-clients N] [--web-root DIR] [--egl auto|device|surfaceless]\n"
+         "               [--quality Q] [--codec auto|jpeg|h264] [--max-clients N] [--web-root DIR]\n"
+         "               [--egl auto|device|surfaceless]\n"
          "               [--debug-overlay] [--rfb-only] [--proxy-protocol] [--ready-fd N]\n"
          "               [--data-dir DIR] [--uid ID] [--code-success C] [--code-timeout C]\n"
          "               [--time-limit S] [--trajectory-hz N]\n"
@@ -52,6 +53,9 @@ std::string sim_usage() {
          "                   a spawn point's name or x,y,yaw in metres and radians\n"
          "  --crowd N        number of pedestrians, 0..500 (default: the scenario's)\n"
          "  --quality Q      JPEG quality 1..100 (default 80)\n"
+         "  --codec C        picture encoding: auto (default: Tight JPEG, H.264 for a client that offers it once\n"
+         "                   its link cannot carry the frame rate), jpeg (Tight JPEG always) or h264 (H.264 for\n"
+         "                   every client that offers it, such as noVNC 1.6+ over https)\n"
          "  --max-clients N  viewers at once, 1..64 (default 4)\n"
          "  --web-root DIR   directory holding the participant page (default: the built page)\n"
          "  --egl P          EGL platform (default auto: GPU device, else Mesa surfaceless)\n"
@@ -64,8 +68,9 @@ std::string sim_usage() {
          "                   that others reach)\n"
          "  --ready-fd N     once listening, write 'ready PORT' and a newline to file descriptor N (3 or\n"
          "                   above, e.g. a pipe from the parent) and keep it open: later lines report the\n"
-         "                   task's outcome ('outcome completed' or 'outcome timeout'); exit 1 if the ready\n"
-         "                   line cannot be written\n"
+         "                   viewers' stream about once a second ('stream codec=tight rtt_ms=12.5 fps=29.8\n"
+         "                   quality=80 clients=1') and the task's outcome ('outcome completed' or 'outcome\n"
+         "                   timeout'); exit 1 if the ready line cannot be written\n"
          "  --data-dir DIR   record the session there: session.json, trajectories.csv, events.jsonl\n"
          "                   (docs/data.md); without it nothing is recorded\n"
          "  --uid ID         participant id recorded in session.json (letters, digits, - and _)\n"
@@ -104,6 +109,10 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
          return true;
        }},
       {"--quality", [&](const std::string& v) { return parse_number(v, 1, 100, o.jpeg_quality); }},
+      {"--codec", [&](const std::string& v) {
+         o.codec = v;
+         return v == "auto" || v == "jpeg" || v == "h264";
+       }},
       {"--max-clients", [&](const std::string& v) { return parse_number(v, 1, 64, o.max_clients); }},
       {"--web-root", [&](const std::string& v) { o.web_root = v; return !v.empty(); }},
       {"--ready-fd", [&](const std::string& v) {
@@ -161,6 +170,8 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
     const std::string& value = args[++i];
     if (!option->second(value)) {
       outcome.error = "bad value '" + value + "' for " + arg;
+      // A choice among names is spelt out, so that a typo is fixed without reading the help.
+      if (arg == "--codec") outcome.error += " (expected auto, jpeg or h264)";
       return outcome;
     }
   }

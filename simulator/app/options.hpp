@@ -23,6 +23,9 @@ struct SimOptions {
   std::optional<std::string> avatar_start, avatar_goal, robot_start, robot_goal;
   std::optional<int> crowd;         ///< number of pedestrians instead of the scenario's
   int jpeg_quality = 80;            ///< 1..100
+  /// Picture encoding for clients: "auto" (Tight JPEG, H.264 once a client's link needs it), "jpeg" or "h264"
+  /// (rfbsim::Codec; kept as text here so that the options need no librfbsim).
+  std::string codec = "auto";
   int max_clients = 4;
   std::string web_root;             ///< empty = the built or installed page
   std::string egl_platform = "auto";
@@ -31,8 +34,9 @@ struct SimOptions {
   bool rfb_only = false;
   /// Each connection begins with a PROXY protocol line naming the real client (sim_manager's relay).
   bool proxy_protocol = false;
-  /// Once listening, write "ready <port>\n" to this file descriptor (3 or above), then one line per
-  /// outcome ("outcome completed\n"); closed when the program ends.
+  /// Once listening, write "ready <port>\n" to this file descriptor (3 or above), then about once a second
+  /// while someone watches a "stream ..." line (app/stream_status.hpp), and one line per outcome
+  /// ("outcome completed\n"); closed when the program ends.
   std::optional<int> ready_fd;
   std::string data_dir;             ///< record session data here (docs/data.md); empty = nothing recorded
   std::string uid;                  ///< participant id for session.json

@@ -54,7 +54,8 @@ std::optional<std::string> Simulation::send_robot_goal(const Pose2& goal) {
   return robot_->send_goal(world_, goal);
 }
 
-std::string status_json(const World& world, int clients, std::uint64_t frames_rendered) {
+std::string status_json(const World& world, int clients, std::uint64_t frames_rendered,
+                        const std::string& streams_json) {
   char text[768];
   std::snprintf(text, sizeof text,
                 "{\"tick\":%llu,\"time\":%.4f,\"clients\":%d,\"frames_rendered\":%llu,"
@@ -73,7 +74,8 @@ std::string status_json(const World& world, int clients, std::uint64_t frames_re
                   r.estimate.y, r.estimate.yaw);
     json += text;
   }
-  return json + "}";
+  // Last, so that readers looking for the first "x", "speed" or "clients" find the world's and the count.
+  return json + ",\"streams\":" + streams_json + "}";
 }
 
 }  // namespace rfbsim::sim

@@ -63,7 +63,9 @@ class Simulation {
 };
 
 /// The status document served at /status.json: tick, time, avatar pose, camera height, people, robot,
-/// contacts so far, plus what the caller adds about clients and frames.
-std::string status_json(const World& world, int clients, std::uint64_t frames_rendered);
+/// contacts so far, plus what the caller adds about clients and frames, and last "streams": `streams_json`, a
+/// JSON array written as given (sim_rfb's viewers' streams, app/stream_status.hpp).
+std::string status_json(const World& world, int clients, std::uint64_t frames_rendered,
+                        const std::string& streams_json = "[]");
 
 }  // namespace rfbsim::sim

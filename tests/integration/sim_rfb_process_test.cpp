@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // sim_rfb as a real process: a real RFB client walks the avatar; command-line and setup errors;
-// --rfb-only and --ready-fd as sim_manager uses them.
+// --rfb-only and --ready-fd as sim_manager uses them; each viewer's stream in /status.json and on the ready pipe.
 #include <sys/wait.h>
 
 #include <catch2/catch.hpp>
@@ -15,6 +15,7 @@
 #include <fstream>
 #include <memory>
 #include <regex>
+#include <sstream>
 #include <thread>
 
 #include "rfb_test_client.hpp"
@@ -27,6 +28,7 @@ using rfbsim::test::http_get;
 using rfbsim::test::json_number;
 using rfbsim::test::RfbTestClient;
 using rfbsim::test::SimProcess;
+using rfbsim::test::UpdateMode;
 
 namespace {
 
@@ -46,6 +48,21 @@ bool await_status(const SimProcess& sim, RfbTestClient* client, Done done, std::
 }
 
 const std::vector<std::string> kSmall = {"--port", "0", "--width", "320", "--height", "240"};
+
+// The "streams" array of a status document ("" when it has none).
+std::string streams_of(const std::string& status) {
+  const auto at = status.find("\"streams\":[");
+  if (at == std::string::npos) return "";
+  const auto end = status.find(']', at);
+  return end == std::string::npos ? "" : status.substr(at + 10, end - at - 9);
+}
+
+// How many stream objects an array text holds.
+std::size_t stream_count(const std::string& streams) {
+  std::size_t count = 0;
+  for (auto at = streams.find("{\"id\":"); at != std::string::npos; at = streams.find("{\"id\":", at + 1)) ++count;
+  return count;
+}
 
 // What sim_rfb finds as descriptor 3.
 enum class Fd3 {
@@ -146,6 +163,12 @@ class ManagedSim {
     }
     return text;
   }
+  /// Appends what the ready pipe yields to `text` until `done(text)`, the pipe's end or `timeout`.
+  template <typename Done>
+  ReadOutcome read_pipe(std::string& text, Done done, std::chrono::milliseconds timeout) {
+    REQUIRE(ready_fd_ >= 0);
+    return read_until(ready_fd_, text, done, timeout);
+  }
   /// Reads stdout and stderr until `pattern` matches them; false on exit or timeout.
   bool await_output(const std::regex& pattern, std::smatch& match, std::chrono::milliseconds timeout = 30s) {
     const auto found = [&](const std::string& text) { return std::regex_search(text, match, pattern); };
@@ -215,6 +238,55 @@ TEST_CASE("holding W walks the avatar and changes the picture") {
   REQUIRE(exit_status != -1);
   CHECK(WIFEXITED(exit_status));
   CHECK(WEXITSTATUS(exit_status) == 0);
+}
+
+TEST_CASE("/status.json lists each viewer's stream: encoding, ContinuousUpdates, round trip") {
+  SimProcess sim(rfbsim::test::sim_rfb_path(), kSmall);
+  std::string status;
+  REQUIRE(await_status(sim, nullptr, [](const std::string& s) { return json_number(s, "tick") > 0; }, status));
+  CHECK(streams_of(status) == "[]");  // nobody watches
+
+  SECTION("a plain libvncclient client asks for each update: Tight, no ContinuousUpdates, no round trip") {
+    RfbTestClient client("127.0.0.1", sim.port());
+    REQUIRE(client.wait_for_updates(2, 10s));
+    REQUIRE(await_status(sim, &client, [](const std::string& s) {
+      return stream_count(streams_of(s)) == 1 && json_number(streams_of(s), "updates_sent") >= 1;
+    }, status));
+    const std::string streams = streams_of(status);
+    INFO(streams);
+    CHECK_THAT(streams, Catch::Contains(R"("encoding":"tight")"));
+    CHECK_THAT(streams, Catch::Contains(R"("continuous_updates":false)"));
+    CHECK_THAT(streams, Catch::Contains(R"("fence":false)"));
+    CHECK_THAT(streams, Catch::Contains(R"("last_rtt_ms":null)"));
+    CHECK(json_number(streams, "quality") >= 1);
+    CHECK(json_number(streams, "quality") <= 100);
+    // Every key, once.
+    for (const char* key : {"id", "encoding", "continuous_updates", "fence", "base_rtt_ms", "last_rtt_ms",
+                            "window_bytes", "in_flight_bytes", "updates_sent", "updates_held", "update_requests", "quality",
+                            "quality_level", "delivery_mbit", "fps"}) {
+      CHECK(streams.find("\"" + std::string(key) + "\":") != std::string::npos);
+    }
+  }
+
+  SECTION("a client that speaks ContinuousUpdates and Fence gets pushed updates and a measured round trip") {
+    RfbTestClient client("127.0.0.1", sim.port(), 8, UpdateMode::kContinuous);
+    REQUIRE(client.pump_until([&] { return client.continuous(); }, 10s));
+    client.send_key('w', true);  // a moving picture: updates keep coming, each with its fence
+    REQUIRE(await_status(sim, &client, [](const std::string& s) {
+      const std::string streams = streams_of(s);
+      return streams.find(R"("continuous_updates":true)") != std::string::npos &&
+             streams.find(R"("last_rtt_ms":null)") == std::string::npos && json_number(streams, "updates_sent") >= 3;
+    }, status));
+    client.send_key('w', false);
+    const std::string streams = streams_of(status);
+    INFO(streams);
+    CHECK(stream_count(streams) == 1);
+    CHECK_THAT(streams, Catch::Contains(R"("encoding":"tight")"));
+    CHECK_THAT(streams, Catch::Contains(R"("fence":true)"));
+    CHECK(json_number(streams, "last_rtt_ms") >= 0);
+    CHECK(json_number(streams, "base_rtt_ms") >= 0);
+    CHECK(client.fences_answered() > 0);
+  }
 }
 
 TEST_CASE("a client that leaves with W held does not leave the avatar walking") {
@@ -313,8 +385,66 @@ TEST_CASE("sim_rfb --rfb-only --ready-fd 3 reports the port on the pipe and serv
   REQUIRE(exit_status != -1);
   CHECK(WIFEXITED(exit_status));
   CHECK(WEXITSTATUS(exit_status) == 0);
-  // The built-in room has no task, so nothing followed the ready line before the pipe closed.
-  CHECK(sim.ready_pipe().empty());
+  // The built-in room has no task, so no outcome followed the ready line before the pipe closed; the viewers'
+  // stream lines may have, if one of them stayed a second.
+  const std::string rest = sim.ready_pipe();
+  CHECK(std::regex_match(rest, std::regex("(stream [^\n]*\n)*")));
+}
+
+TEST_CASE("sim_rfb tells its parent the viewer's stream on the ready pipe about once a second") {
+  std::vector<std::string> args = kSmall;
+  args.insert(args.end(), {"--rfb-only", "--ready-fd", "3", "--fps", "20"});
+  ManagedSim sim(args, Fd3::kPipe);
+  std::smatch ready_match;
+  const std::string ready = sim.ready_line();
+  REQUIRE(std::regex_match(ready, ready_match, std::regex("ready ([0-9]+)\n")));
+
+  // Pumps the client while reading the pipe, until a line matching `pattern` has come; the lines so far.
+  const auto await_line = [&](RfbTestClient* client, const std::regex& pattern, std::string& lines) {
+    const auto deadline = std::chrono::steady_clock::now() + 15s;
+    const auto found = [&](const std::string& text) { return std::regex_search(text, pattern); };
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (client != nullptr) client->pump_until([] { return false; }, 50ms);
+      if (sim.read_pipe(lines, found, 50ms) == ReadOutcome::kDone) return true;
+    }
+    return false;
+  };
+  std::string lines;
+  {
+    RfbTestClient client("127.0.0.1", std::stoi(ready_match[1]));
+    client.send_key('w', true);  // a moving picture, so that updates keep coming
+    // The participant's stream: libvncclient asks for each update, so Tight and no measured round trip.
+    const std::regex watched(R"(stream codec=tight rtt_ms=-1 fps=([0-9]+\.[0-9]) quality=([0-9]+) clients=1
+)");
+    REQUIRE(await_line(&client, watched, lines));
+    // A second later, another.
+    const auto first = std::chrono::steady_clock::now();
+    std::string more;
+    REQUIRE(await_line(&client, watched, more));
+    const double gap = std::chrono::duration<double>(std::chrono::steady_clock::now() - first).count();
+    CHECK(gap > 0.5);
+    CHECK(gap < 3.0);
+    std::smatch match;
+    REQUIRE(std::regex_search(more, match, watched));
+    CHECK(std::stod(match[1]) > 0.0);   // updates flow
+    CHECK(std::stod(match[1]) <= 40.0);  // about the frame rate (20), give or take the second's edges
+    CHECK(std::stoi(match[2]) == 80);    // the default quality
+    lines += more;
+    client.send_key('w', false);
+  }
+  // The viewer left: one line says so.
+  std::string after;
+  REQUIRE(await_line(nullptr, std::regex("stream clients=0\n"), after));
+  lines += after;
+  // Every line on the pipe is a stream line, each short enough for one atomic write.
+  std::istringstream in(lines);
+  for (std::string line; std::getline(in, line);) {
+    CHECK(line.rfind("stream ", 0) == 0);
+    CHECK(line.size() < 100);
+  }
+  const int exit_status = sim.exit_status(SIGTERM);
+  CHECK(WIFEXITED(exit_status));
+  CHECK(WEXITSTATUS(exit_status) == 0);
 }
 
 TEST_CASE("a ready fd that cannot be written ends sim_rfb with 1 and says why") {

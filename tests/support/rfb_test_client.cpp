@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 
 namespace rfbsim::test {
@@ -35,9 +36,91 @@ rfbBool resize_framebuffer(rfbClient* client) {
   return TRUE;
 }
 
+void put_u16(std::vector<std::uint8_t>& out, int value) {
+  out.push_back(static_cast<std::uint8_t>(value >> 8));
+  out.push_back(static_cast<std::uint8_t>(value));
+}
+
+// EnableContinuousUpdates (150): U8 enable, U16 x, y, w, h.
+std::vector<std::uint8_t> enable_continuous_message(bool enable, int width, int height) {
+  std::vector<std::uint8_t> out{150, static_cast<std::uint8_t>(enable ? 1 : 0)};
+  put_u16(out, 0);
+  put_u16(out, 0);
+  put_u16(out, width);
+  put_u16(out, height);
+  return out;
+}
+
+// libvncclient sends an incremental update request after each update unless the server's
+// SupportedMessages say it may not: clearing that bit is how a ContinuousUpdates client goes quiet.
+void allow_update_requests(rfbClient* client, bool allow) {
+  std::uint8_t& bits = client->supportedMessages.client2server[rfbFramebufferUpdateRequest / 8];
+  const auto bit = static_cast<std::uint8_t>(1U << (rfbFramebufferUpdateRequest % 8));
+  bits = allow ? static_cast<std::uint8_t>(bits | bit) : static_cast<std::uint8_t>(bits & ~bit);
+}
+
+// The encodings the extension adds to SetEncodings: libvncclient's extension list is global, so the
+// list is filled per client, under a lock, for the length of that client's handshake.
+std::mutex g_offer_mutex;
+int g_offered_encodings[3] = {0, 0, 0};
+
 }  // namespace
 
-RfbTestClient::RfbTestClient(const std::string& host, int port, int quality) {
+// Fence and ContinuousUpdates for libvncclient, which has neither: server messages 150 and 248 reach
+// handleMessage with only their type byte read.
+struct StreamingExtension {
+  static rfbBool handle(rfbClient* client, rfbServerToClientMsg* message) {
+    auto* self = static_cast<RfbTestClient*>(rfbClientGetClientData(client, &g_tag));
+    if (self == nullptr || self->mode_ != UpdateMode::kContinuous) return FALSE;
+    if (message->type == 150) {
+      // The first EndOfContinuousUpdates says the server does them: turn them on (as noVNC does). A later
+      // one ends them: requests are needed again.
+      ++self->end_of_continuous_;
+      if (self->end_of_continuous_ == 1) {
+        const auto enable = enable_continuous_message(true, client->width, client->height);
+        WriteToRFBServer(client, reinterpret_cast<const char*>(enable.data()), static_cast<unsigned>(enable.size()));
+        allow_update_requests(client, false);
+        self->continuous_ = true;
+      } else {
+        self->continuous_ = false;
+        allow_update_requests(client, true);
+        SendIncrementalFramebufferUpdateRequest(client);
+      }
+      return TRUE;
+    }
+    if (message->type == 248) {
+      std::uint8_t head[8];
+      if (!ReadFromRFBServer(client, reinterpret_cast<char*>(head), sizeof head)) return FALSE;
+      const std::uint32_t flags = (std::uint32_t{head[3]} << 24) | (std::uint32_t{head[4]} << 16) |
+                                  (std::uint32_t{head[5]} << 8) | head[6];
+      std::uint8_t payload[255];
+      if (head[7] > 0 && !ReadFromRFBServer(client, reinterpret_cast<char*>(payload), head[7])) return FALSE;
+      if ((flags & (1U << 31)) == 0 || head[7] > 64) {
+        ++self->bad_fences_;
+        return TRUE;
+      }
+      // Answer: Request cleared, BlockBefore/BlockAfter kept (handled in order anyway), payload echoed.
+      std::vector<std::uint8_t> answer{248, 0, 0, 0, 0, 0, 0, static_cast<std::uint8_t>(flags & 3U), head[7]};
+      answer.insert(answer.end(), payload, payload + head[7]);
+      WriteToRFBServer(client, reinterpret_cast<const char*>(answer.data()), static_cast<unsigned>(answer.size()));
+      ++self->fences_answered_;
+      return TRUE;
+    }
+    return FALSE;
+  }
+
+  static void register_once() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+      static rfbClientProtocolExtension extension{};
+      extension.encodings = g_offered_encodings;
+      extension.handleMessage = handle;
+      rfbClientRegisterExtension(&extension);
+    });
+  }
+};
+
+RfbTestClient::RfbTestClient(const std::string& host, int port, int quality, UpdateMode mode) : mode_(mode) {
   if (std::getenv("RFBSIM_VNC_LOG") == nullptr) {
     rfbClientLog = quiet_log;
     rfbClientErr = quiet_log;
@@ -56,6 +139,10 @@ RfbTestClient::RfbTestClient(const std::string& host, int port, int quality) {
   client_->FinishedFrameBufferUpdate = on_update_finished;
   rfbClientSetClientData(client_, &g_tag, this);
   rfbClientSetClientData(client_, &g_tag + 1, &pixels_);
+  StreamingExtension::register_once();
+  const std::lock_guard offer_lock(g_offer_mutex);
+  g_offered_encodings[0] = mode == UpdateMode::kContinuous ? -312 : 0;  // Fence
+  g_offered_encodings[1] = mode == UpdateMode::kContinuous ? -313 : 0;  // ContinuousUpdates
   // On failure rfbInitClient frees the client itself.
   if (!rfbInitClient(client_, nullptr, nullptr)) {
     client_ = nullptr;
@@ -80,7 +167,9 @@ bool RfbTestClient::pump_until(const std::function<bool()>& done, std::chrono::m
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (!done()) {
     if (!connected_ || std::chrono::steady_clock::now() >= deadline) return done();
-    const int ready = WaitForMessage(client_, 20000);  // microseconds
+    // libvncclient reads ahead into its own buffer: messages already there (a fence right behind an
+    // update) are handled before waiting on the socket, which would not show them.
+    const int ready = client_->buffered > 0 ? 1 : WaitForMessage(client_, 20000);  // microseconds
     if (ready < 0) {
       connected_ = false;
     } else if (ready > 0 && !HandleRFBServerMessage(client_)) {
@@ -105,6 +194,15 @@ std::string RfbTestClient::desktop_name() const { return client_->desktopName ? 
 void RfbTestClient::send_key(std::uint32_t keysym, bool down) { SendKeyEvent(client_, keysym, down ? TRUE : FALSE); }
 
 void RfbTestClient::send_pointer(int x, int y, int buttons) { SendPointerEvent(client_, x, y, buttons); }
+
+bool RfbTestClient::send_raw(const std::vector<std::uint8_t>& bytes) {
+  return WriteToRFBServer(client_, reinterpret_cast<const char*>(bytes.data()), static_cast<unsigned>(bytes.size())) !=
+         FALSE;
+}
+
+void RfbTestClient::disable_continuous() {
+  send_raw(enable_continuous_message(false, client_->width, client_->height));
+}
 
 double mean_abs_difference(const FrameView& a, const FrameView& b) {
   if (a.width != b.width || a.height != b.height) return std::numeric_limits<double>::infinity();

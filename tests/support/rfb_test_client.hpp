@@ -15,11 +15,18 @@ struct _rfbClient;
 
 namespace rfbsim::test {
 
+/// How the client asks for pictures.
+enum class UpdateMode {
+  kRequests,    ///< a plain client: one FramebufferUpdateRequest after each update (libvncclient's way)
+  kContinuous,  ///< lists Fence and ContinuousUpdates, answers fences, enables ContinuousUpdates at the
+                ///< server's first EndOfContinuousUpdates and from then on sends no update request
+};
+
 class RfbTestClient {
  public:
   /// Connects and completes the RFB handshake, asking for Tight with JPEG at `quality` (0..9).
   /// Throws std::runtime_error when the connection or the handshake fails.
-  RfbTestClient(const std::string& host, int port, int quality = 8);
+  RfbTestClient(const std::string& host, int port, int quality = 8, UpdateMode mode = UpdateMode::kRequests);
   ~RfbTestClient();
   RfbTestClient(const RfbTestClient&) = delete;
   RfbTestClient& operator=(const RfbTestClient&) = delete;
@@ -43,9 +50,28 @@ class RfbTestClient {
 
   void send_key(std::uint32_t keysym, bool down);
   void send_pointer(int x, int y, int buttons);
+  /// Sends raw bytes as they are (a whole client message, or a malformed one).
+  bool send_raw(const std::vector<std::uint8_t>& bytes);
+
+  /// kContinuous: whether ContinuousUpdates are on (enabled, and not ended by the server since).
+  [[nodiscard]] bool continuous() const { return continuous_; }
+  /// EndOfContinuousUpdates messages received.
+  [[nodiscard]] int end_of_continuous_updates() const { return end_of_continuous_; }
+  /// Server fences answered (every one had the Request bit; one without it counts in bad_fences()).
+  [[nodiscard]] int fences_answered() const { return fences_answered_; }
+  /// Server fences without the Request bit or with a payload over 64 bytes (noVNC fails on those).
+  [[nodiscard]] int bad_fences() const { return bad_fences_; }
+  /// kContinuous: asks the server to stop pushing (EnableContinuousUpdates with enable 0).
+  void disable_continuous();
 
  private:
   static void on_update_finished(_rfbClient* client);
+  friend struct StreamingExtension;
+  UpdateMode mode_ = UpdateMode::kRequests;
+  bool continuous_ = false;
+  int end_of_continuous_ = 0;
+  int fences_answered_ = 0;
+  int bad_fences_ = 0;
   _rfbClient* client_ = nullptr;
   std::vector<std::uint8_t> pixels_;
   std::uint64_t updates_ = 0;

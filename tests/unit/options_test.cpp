@@ -97,3 +97,18 @@ TEST_CASE("the rfb-only flag takes no value and excludes --web-root") {
   CHECK(parse_sim_options({"--web-root", "/tmp/w", "--rfb-only"}).error == "--rfb-only serves no page; drop --web-root");
   CHECK(rfbsim::sim::sim_usage().find("--rfb-only") != std::string::npos);
 }
+
+TEST_CASE("the codec option takes auto, jpeg or h264 and names the choices when it is wrong") {
+  CHECK(parse_sim_options({}).options.codec == "auto");
+  for (const char* codec : {"auto", "jpeg", "h264"}) {
+    const auto o = parse_sim_options({"--codec", codec, "--port", "0"});
+    REQUIRE(o.error.empty());
+    CHECK(o.options.codec == codec);
+    CHECK(o.options.port == 0);
+  }
+  CHECK(parse_sim_options({"--codec", "H264"}).error == "bad value 'H264' for --codec (expected auto, jpeg or h264)");
+  CHECK(parse_sim_options({"--codec", "tight"}).error == "bad value 'tight' for --codec (expected auto, jpeg or h264)");
+  CHECK(parse_sim_options({"--codec", ""}).error == "bad value '' for --codec (expected auto, jpeg or h264)");
+  CHECK(parse_sim_options({"--codec"}).error == "--codec needs a value");
+  CHECK(rfbsim::sim::sim_usage().find("--codec auto|jpeg|h264") != std::string::npos);
+}

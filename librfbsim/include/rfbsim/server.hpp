@@ -27,6 +27,35 @@ namespace rfbsim {
 /// JPEG chroma subsampling for Tight encoding.
 enum class Subsampling : std::uint8_t { k444, k422, k420, kGray };
 
+/// Which picture encoding clients get. Tight JPEG works with every client; H.264 (the open H.264
+/// rectangle, RFB encoding 50) only with clients that offer it (noVNC >= 1.6 in a browser with WebCodecs,
+/// which needs a secure context: https, or http on localhost).
+enum class Codec : std::uint8_t {
+  kAuto,  ///< Tight JPEG first; H.264 for a client that offers it once its link cannot carry the frame rate
+          ///< at the configured JPEG quality (then it stays on H.264)
+  kJpeg,  ///< Tight JPEG always
+  kH264,  ///< H.264 for every client that offers it, Tight JPEG for the others
+};
+
+/// One client's stream as the server sees it now, for status pages.
+struct ClientStreamStatus {
+  int id = 0;                       ///< ClientInfo::id
+  std::string encoding;             ///< "tight" or "h264"
+  bool continuous_updates = false;  ///< updates pushed (ContinuousUpdates) rather than requested
+  bool fence = false;               ///< the client answers fences (congestion control is possible)
+  double base_rtt_ms = -1;          ///< lowest round trip seen through fences; -1 = not measured yet
+  double last_rtt_ms = -1;          ///< the latest round trip; -1 = not measured yet
+  std::uint32_t window_bytes = 0;   ///< congestion window: bytes allowed in flight
+  std::uint64_t in_flight_bytes = 0;  ///< bytes sent and not yet known to have arrived
+  std::uint64_t updates_sent = 0;   ///< framebuffer updates sent to this client
+  std::uint64_t updates_held = 0;   ///< new frames held back because the link was full (they coalesce)
+  std::uint64_t update_requests = 0;  ///< FramebufferUpdateRequests received (few once continuous)
+  int quality = 0;                  ///< JPEG quality in use (Tight), or the configured one (H.264)
+  int quality_level = 0;            ///< 0 = the configured quality; each step down is one more
+  double delivery_mbit = 0;         ///< the link's measured rate while full, Mbit/s; 0 = unknown
+  double fps = 0;                   ///< updates per second over the last second or so
+};
+
 /// A client as the connect and disconnect callbacks see it.
 struct ClientInfo {
   int id = 0;               ///< unique per server, counting from 1
@@ -55,6 +84,12 @@ struct ServerOptions {
   int height = 720;                          ///< framebuffer height in pixels (16..8192)
   int jpeg_quality = 80;                     ///< 1..100, imposed on Tight clients; 0 = respect the client's level
   Subsampling subsampling = Subsampling::k420;  ///< imposed together with jpeg_quality
+  /// Lower JPEG quality (then frame rate) for a client whose link cannot carry the frame rate, and raise it
+  /// again when it can; refresh a still picture at full quality. Needs jpeg_quality > 0 and a client that
+  /// does ContinuousUpdates and Fence (noVNC); others get jpeg_quality always.
+  bool adaptive_quality = true;
+  Codec codec = Codec::kAuto;                ///< see Codec
+  int frame_rate = 30;                       ///< the rate the host submits frames at (H.264 timing), 1..240
   int max_clients = 4;                       ///< further RFB clients are refused
   bool view_only = false;                    ///< ignore every key and pointer event
   std::string desktop_name = "rfbsim";       ///< the name RFB clients show
@@ -107,6 +142,9 @@ class Server {
   [[nodiscard]] int client_count() const;
   /// A snapshot of the counters.
   [[nodiscard]] ServerStats stats() const;
+  /// Each connected client's stream (codec, round trip, window, quality); safe from any thread, at most
+  /// one network-thread pass old.
+  [[nodiscard]] std::vector<ClientStreamStatus> client_streams() const;
   /// The options the server runs with.
   [[nodiscard]] const ServerOptions& options() const;
 

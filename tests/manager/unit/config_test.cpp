@@ -40,6 +40,7 @@ TEST_CASE("the defaults") {
   CHECK(c.session_command == "sim_rfb");
   CHECK(c.session_kind == SessionKind::kSimRfb);
   CHECK(c.session_args.empty());
+  CHECK(c.codec == "auto");
   CHECK(c.max_sessions == 4);
   CHECK(c.max_duration == seconds(300));
   CHECK(c.idle_timeout == seconds(60));
@@ -81,6 +82,7 @@ tls_private_key: /etc/rfbsim/key.pem
 session_command: /opt/rfbsim/bin/sim_rfb
 session_kind: rfb
 session_args: ["--listen", "127.0.0.1:{port}", "--quiet"]
+codec: h264
 max_sessions: 12
 max_duration_s: 600
 idle_timeout_s: 90
@@ -112,6 +114,7 @@ limit_cpu_slack_s: 30
   CHECK(c.session_command == "/opt/rfbsim/bin/sim_rfb");
   CHECK(c.session_kind == SessionKind::kRfb);
   CHECK(c.session_args == Strings{"--listen", "127.0.0.1:{port}", "--quiet"});
+  CHECK(c.codec == "h264");
   CHECK(c.max_sessions == 12);
   CHECK(c.max_duration == seconds(600));
   CHECK(c.idle_timeout == seconds(90));
@@ -209,6 +212,9 @@ TEST_CASE("bad values name the file, the line, the key and what is expected") {
   CHECK(error("admin_token: 0123456789abcde") == at + "admin_token: must be at least 16 characters");
   CHECK(error("link_secret: short") == at + "link_secret: must be at least 16 characters");
   CHECK(error("session_kind: docker") == at + "session_kind: expected sim_rfb or rfb");
+  CHECK(error("codec: vp9") == at + "codec: expected auto, jpeg or h264");
+  CHECK(error("codec: H264") == at + "codec: expected auto, jpeg or h264");
+  CHECK(error("codec: \"\"") == at + "codec: expected auto, jpeg or h264");
   CHECK(error("scenarios: [lab, ../x]") ==
         at + "scenarios: '../x' is not a scenario name (letters, digits, - and _, at most 64), optionally =FILE");
   CHECK(error("scenarios: []") == at + "scenarios: list at least one scenario");
@@ -272,6 +278,17 @@ TEST_CASE("flags set the config") {
   CHECK(outcome.config.idle_timeout == seconds(15));
   CHECK(outcome.config.limits.cpu_time_factor == 0.0);
   CHECK(outcome.config.public_url == "http://10.0.0.2:8080");
+}
+
+TEST_CASE("the codec is a key and a flag, the flag winning, each value checked") {
+  ScratchDir dir;
+  const std::string path = dir.write("manager.yaml", "port: 8000\ncodec: jpeg\n");
+  CHECK(parse_manager_args({"--config", path}).config.codec == "jpeg");
+  CHECK(parse_manager_args({"--config", path, "--codec", "h264"}).config.codec == "h264");
+  CHECK(parse_manager_args({"--codec", "auto"}).config.codec == "auto");
+  CHECK(args_error({"--codec", "x264"}) == "--codec 'x264': expected auto, jpeg or h264");
+  CHECK(args_error({"--codec"}) == "--codec needs a value");
+  CHECK_THAT(manager_usage(), Contains("--codec auto|jpeg|h264"));
 }
 
 TEST_CASE("flags override the config file wherever --config stands") {

@@ -30,7 +30,23 @@ TEST_CASE("sim_rfb gets its fixed flags, the scenario, the seed and where to rec
   const LaunchContext context{7, 0, "/data/p01-1"};
   CHECK(session_arguments(config, request("lab"), context) ==
         Args{"--port", "0", "--bind", "127.0.0.1", "--rfb-only", "--ready-fd", "3", "--scenario", "lab", "--seed", "7",
-             "--proxy-protocol", "--data-dir", "/data/p01-1", "--uid", "p01"});
+             "--proxy-protocol", "--data-dir", "/data/p01-1", "--uid", "p01", "--codec", "auto"});
+}
+
+TEST_CASE("sim_rfb gets the configured codec, and only sim_rfb does") {
+  ManagerConfig config;
+  config.codec = "h264";
+  const LaunchContext context{7, 0, "/data/p01-1"};
+  const Args args = session_arguments(config, request("lab"), context);
+  const auto codec = std::find(args.begin(), args.end(), "--codec");
+  REQUIRE(codec != args.end());
+  REQUIRE(codec + 1 != args.end());
+  CHECK(*(codec + 1) == "h264");
+  CHECK(std::count(args.begin(), args.end(), "--codec") == 1);
+  // A legacy RFB program gets its own argument list and nothing else.
+  config.session_kind = SessionKind::kRfb;
+  config.session_args = {"--rfbport", "{port}"};
+  CHECK(session_arguments(config, request("lab"), LaunchContext{7, 5901, "/d"}) == Args{"--rfbport", "5901"});
 }
 
 TEST_CASE("sim_rfb gets the link's completion codes, each only when the link has it") {
@@ -79,6 +95,8 @@ TEST_CASE("sim_rfb gets one flag per override, then the configured extra argumen
                                                        "/data/p01-1",
                                                        "--uid",
                                                        "p01",
+                                                       "--codec",
+                                                       "auto",
                                                        "--width",
                                                        "1280",
                                                        "--fps=30"});

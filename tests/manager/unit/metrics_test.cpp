@@ -11,6 +11,8 @@ using rfbsim::manager::RelayCounts;
 using rfbsim::manager::RelayKind;
 using rfbsim::manager::rejection_name;
 using rfbsim::manager::SessionState;
+using rfbsim::manager::SessionStream;
+using rfbsim::manager::StreamReport;
 
 namespace {
 
@@ -57,8 +59,11 @@ TEST_CASE("every series has its HELP and TYPE") {
                                                "# TYPE rfbsim_relay_connections gauge",
                                                "# TYPE rfbsim_relay_connections_total counter",
                                                "# TYPE rfbsim_rejections_total counter",
+                                               "# TYPE rfbsim_session_rtt_ms gauge",
+                                               "# TYPE rfbsim_session_fps gauge",
+                                               "# TYPE rfbsim_session_codec_info gauge",
                                            });
-  CHECK(lines_starting(text, "# HELP ").size() == 8);
+  CHECK(lines_starting(text, "# HELP ").size() == 11);
 }
 
 TEST_CASE("sessions are listed for every state, zero included") {
@@ -163,4 +168,36 @@ TEST_CASE("rejections are counted by reason and every reason is listed") {
 TEST_CASE("rejection reasons have their label names") {
   CHECK(std::string(rejection_name(Rejection::kCompleted)) == "already_completed");
   CHECK(std::string(rejection_name(Rejection::kForbiddenOrigin)) == "forbidden_origin");
+}
+
+TEST_CASE("each watched session's stream is a series labelled with its id, and only what is known") {
+  const Metrics metrics;
+  const std::vector<SessionStream> streams = {
+      {12, StreamReport{1, "h264", 52.3, 29.7, 80}},
+      {3, StreamReport{2, "tight", std::nullopt, 15, 60}},  // a client without fences: no round trip
+      {7, StreamReport{0, "tight", 10, 30, 80}},            // nobody watches any more: no series
+  };
+  const std::string text = metrics.render({}, 4, {}, streams);
+  CHECK(lines_starting(text, "rfbsim_session_rtt_ms{") == std::vector<std::string>{
+                                                             "rfbsim_session_rtt_ms{session=\"12\"} 52.3",
+                                                         });
+  CHECK(lines_starting(text, "rfbsim_session_fps{") == std::vector<std::string>{
+                                                          "rfbsim_session_fps{session=\"12\"} 29.7",
+                                                          "rfbsim_session_fps{session=\"3\"} 15",
+                                                      });
+  CHECK(lines_starting(text, "rfbsim_session_codec_info{") ==
+        std::vector<std::string>{
+            "rfbsim_session_codec_info{session=\"12\",codec=\"h264\"} 1",
+            "rfbsim_session_codec_info{session=\"3\",codec=\"tight\"} 1",
+        });
+  // Without streams the metrics are announced and have no series.
+  const std::string none = metrics.render({}, 4, {});
+  CHECK(has_line(none, "# TYPE rfbsim_session_rtt_ms gauge"));
+  CHECK(lines_starting(none, "rfbsim_session_rtt_ms{").empty());
+  CHECK(lines_starting(none, "rfbsim_session_codec_info{").empty());
+}
+
+TEST_CASE("a label value that is not plain cannot break the exposition text") {
+  const std::string text = Metrics().render({}, 4, {}, {{5, StreamReport{1, "a\"b\\c\nd", 1, 1, 1}}});
+  CHECK(has_line(text, R"(rfbsim_session_codec_info{session="5",codec="a\"b\\c\nd"} 1)"));
 }

@@ -86,7 +86,26 @@ TEST_CASE("the admin API's session JSON names every field, and the token only wh
   const std::string expected =
       R"({"id":7,"uid":"p-01","scenario":"lab","seed":"42","state":"running","detail":"said \"hi\"",)"
       R"("exit_status":"","created_at":"2026-11-24T10:00:00.000Z","ready_at":"2026-11-24T10:00:00.250Z",)"
-      R"("ended_at":null,"data_path":"/data/sessions/7-p-01","outcome":null,"params":{"uid":"p-01","scenario":"lab","seed":"42"})";
+      R"("ended_at":null,"data_path":"/data/sessions/7-p-01","outcome":null,)"
+      R"("params":{"uid":"p-01","scenario":"lab","seed":"42"},"codec":null,"rtt_ms":null,"fps":null)";
   CHECK(rfbsim::manager::session_json(s, false) == expected + "}");
   CHECK(rfbsim::manager::session_json(s, true) == expected + R"(,"token":"0123456789abcdef0123456789abcdef"})");
+}
+
+TEST_CASE("the admin API's session JSON carries the participant's stream while someone watches") {
+  Session s = sample();
+  const auto stream_part = [&] {
+    const std::string json = rfbsim::manager::session_json(s, false);
+    return json.substr(json.find(R"("codec")"));
+  };
+  CHECK(stream_part() == R"("codec":null,"rtt_ms":null,"fps":null})");
+  s.stream = rfbsim::manager::StreamReport{1, "h264", 52.34, 29.66, 80};
+  CHECK(stream_part() == R"("codec":"h264","rtt_ms":52.3,"fps":29.7})");
+  // A stream without a measured round trip (a client without fences) says so with null.
+  s.stream->rtt_ms.reset();
+  s.stream->codec = "tight";
+  CHECK(stream_part() == R"("codec":"tight","rtt_ms":null,"fps":29.7})");
+  // Nobody watching: nothing to show, whatever was reported before.
+  s.stream->clients = 0;
+  CHECK(stream_part() == R"("codec":null,"rtt_ms":null,"fps":null})");
 }

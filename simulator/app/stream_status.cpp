@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The viewers' streams as /status.json's "streams" array and as the ready pipe's "stream" line.
+#include "app/stream_status.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace rfbsim::sim {
+
+namespace {
+
+// A codec's name as the line and the JSON carry it: 1 to 16 lower-case letters and digits; "" for anything
+// else, which is then left out rather than passed on to sim_manager's labels and pages.
+std::string clean_name(const std::string& name) {
+  if (name.empty() || name.size() > 16) return "";
+  for (const char c : name) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'))) return "";
+  }
+  return name;
+}
+
+// A number for JSON with `decimals` decimals; null when it is not finite (never expected, never invalid JSON).
+std::string json_number(double value, int decimals) {
+  if (!std::isfinite(value)) return "null";
+  char text[48];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  return text;
+}
+
+// A round trip for JSON: null while not measured (the library says -1).
+std::string json_rtt(double ms) { return ms < 0 ? "null" : json_number(ms, 1); }
+
+// `value` limited to low..high; low when it is not finite.
+double clamped(double value, double low, double high) {
+  return std::isfinite(value) ? std::clamp(value, low, high) : low;
+}
+
+}  // namespace
+
+const rfbsim::ClientStreamStatus* main_stream(const std::vector<rfbsim::ClientStreamStatus>& streams) {
+  const rfbsim::ClientStreamStatus* best = nullptr;
+  for (const rfbsim::ClientStreamStatus& stream : streams) {
+    if (best == nullptr || stream.updates_sent > best->updates_sent ||
+        (stream.updates_sent == best->updates_sent && stream.id < best->id)) {
+      best = &stream;
+    }
+  }
+  return best;
+}
+
+std::string streams_json(const std::vector<rfbsim::ClientStreamStatus>& streams) {
+  std::string json = "[";
+  for (const rfbsim::ClientStreamStatus& s : streams) {
+    if (json.size() > 1) json += ",";
+    const std::string encoding = clean_name(s.encoding);
+    json += "{\"id\":" + std::to_string(s.id) +
+            ",\"encoding\":" + (encoding.empty() ? std::string("null") : "\"" + encoding + "\"") +
+            ",\"continuous_updates\":" + (s.continuous_updates ? "true" : "false") +
+            ",\"fence\":" + (s.fence ? "true" : "false") + ",\"base_rtt_ms\":" + json_rtt(s.base_rtt_ms) +
+            ",\"last_rtt_ms\":" + json_rtt(s.last_rtt_ms) + ",\"window_bytes\":" + std::to_string(s.window_bytes) +
+            ",\"in_flight_bytes\":" + std::to_string(s.in_flight_bytes) +
+            ",\"updates_sent\":" + std::to_string(s.updates_sent) +
+            ",\"updates_held\":" + std::to_string(s.updates_held) +
+            ",\"update_requests\":" + std::to_string(s.update_requests) + ",\"quality\":" + std::to_string(s.quality) +
+            ",\"quality_level\":" + std::to_string(s.quality_level) +
+            ",\"delivery_mbit\":" + json_number(s.delivery_mbit, 2) + ",\"fps\":" + json_number(s.fps, 1) + "}";
+  }
+  return json + "]";
+}
+
+std::string stream_line(const std::vector<rfbsim::ClientStreamStatus>& streams) {
+  const rfbsim::ClientStreamStatus* participant = main_stream(streams);
+  const int clients = static_cast<int>(std::min<std::size_t>(streams.size(), 9999));
+  if (participant == nullptr) return "stream clients=0\n";
+  // Every value bounded, so that the line stays short: 600000 ms is ten minutes, 1000 fps beyond any display.
+  std::string line = "stream";
+  const std::string codec = clean_name(participant->encoding);
+  if (!codec.empty()) line += " codec=" + codec;
+  char rtt[32] = " rtt_ms=-1";
+  if (participant->last_rtt_ms >= 0) {
+    std::snprintf(rtt, sizeof rtt, " rtt_ms=%.1f", clamped(participant->last_rtt_ms, 0, 600000));
+  }
+  char rest[64];
+  std::snprintf(rest, sizeof rest, " fps=%.1f quality=%d clients=%d\n", clamped(participant->fps, 0, 1000),
+                std::clamp(participant->quality, 0, 100), clients);
+  return line + rtt + rest;
+}
+
+}  // namespace rfbsim::sim

@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// H.264 (the open H.264 rectangle, encoding 50) end to end: the in-process server encodes, a client that
+// decodes with libavcodec (tests/support's H264RfbClient) shows the served picture; clients that do not
+// offer 50 get Tight JPEG from the same server.
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <thread>
+#include <vector>
+
+#include "h264_rfb_client.hpp"
+#include "rfb_test_client.hpp"
+#include "rfbsim/server.hpp"
+
+using namespace std::chrono_literals;
+using rfbsim::test::H264RfbClient;
+using rfbsim::test::RfbTestClient;
+
+namespace {
+
+constexpr int kWidth = 320;
+constexpr int kHeight = 240;
+
+// A smooth picture that depends on `k`: a diagonal gradient with a bright square whose place moves.
+std::vector<std::uint8_t> picture(int k) {
+  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(kWidth) * kHeight * 4U);
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      std::uint8_t* p = &pixels[(static_cast<std::size_t>(y) * kWidth + static_cast<std::size_t>(x)) * 4U];
+      const bool square = x >= 20 + k * 10 && x < 60 + k * 10 && y >= 40 && y < 80;
+      p[0] = square ? 250 : static_cast<std::uint8_t>(x * 255 / kWidth);
+      p[1] = square ? 240 : static_cast<std::uint8_t>(y * 255 / kHeight);
+      p[2] = square ? 30 : static_cast<std::uint8_t>(128 + (x + y) / 8);
+      p[3] = 255;
+    }
+  }
+  return pixels;
+}
+
+rfbsim::ServerOptions h264_server(rfbsim::Codec codec = rfbsim::Codec::kH264) {
+  rfbsim::ServerOptions options;
+  options.width = kWidth;
+  options.height = kHeight;
+  options.codec = codec;
+  return options;
+}
+
+void submit(rfbsim::Server& server, const std::vector<std::uint8_t>& pixels) {
+  server.submit(rfbsim::FrameView{pixels.data(), kWidth, kHeight, 0});
+}
+
+bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() >= deadline) return condition();
+    std::this_thread::sleep_for(10ms);
+  }
+  return true;
+}
+
+std::string encoding_of(const rfbsim::Server& server, int id) {
+  for (const auto& stream : server.client_streams()) {
+    if (stream.id == id) return stream.encoding;
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("an H.264 client gets pictures that decode to the served frames", "[streaming][h264]") {
+  rfbsim::Server server(h264_server());
+  H264RfbClient client("127.0.0.1", server.port());
+  for (int k = 0; k < 8; ++k) {
+    const auto pixels = picture(k);
+    submit(server, pixels);
+    const rfbsim::FrameView served{pixels.data(), kWidth, kHeight, 0};
+    // Smooth content at CRF 23: the decoded picture is within a few levels of the source everywhere.
+    INFO("frame " << k);
+    CHECK(client.pump_until([&] { return rfbsim::test::mean_abs_difference(client.frame(), served) < 3.0; }, 10s));
+  }
+  CHECK(client.h264_pictures() >= 8);
+  CHECK(client.idr_pictures() >= 1);
+  CHECK(client.decode_errors() == 0);
+  CHECK(client.raw_rects() == 0);  // every picture came as H.264
+  CHECK(client.continuous());
+  CHECK(client.bad_fences() == 0);
+  REQUIRE(eventually([&] { return encoding_of(server, 1) == "h264"; }, 5s));
+}
+
+TEST_CASE("a full update request restarts the H.264 stream with an IDR", "[streaming][h264]") {
+  rfbsim::Server server(h264_server());
+  H264RfbClient client("127.0.0.1", server.port());
+  submit(server, picture(0));
+  REQUIRE(client.wait_for_updates(1, 10s));
+  const auto idrs = client.idr_pictures();
+  submit(server, picture(1));
+  REQUIRE(client.wait_for_updates(1, 10s));
+  CHECK(client.idr_pictures() == idrs);  // a changed frame is a P picture
+  // FramebufferUpdateRequest, non-incremental, whole screen.
+  const std::vector<std::uint8_t> full_request{3, 0, 0, 0, 0, 0, 0x01, 0x40, 0x00, 0xF0};
+  REQUIRE(client.send_raw(full_request));
+  CHECK(client.pump_until([&] { return client.idr_pictures() > idrs; }, 10s));
+  CHECK(client.decode_errors() == 0);
+}
+
+TEST_CASE("with codec h264, clients that do not offer it get Tight beside an H.264 client", "[streaming][h264]") {
+  rfbsim::Server server(h264_server());
+  H264RfbClient h264("127.0.0.1", server.port());
+  RfbTestClient tight("127.0.0.1", server.port());
+  for (int k = 0; k < 3; ++k) {
+    const auto pixels = picture(k);
+    submit(server, pixels);
+    const rfbsim::FrameView served{pixels.data(), kWidth, kHeight, 0};
+    CHECK(h264.pump_until([&] { return rfbsim::test::mean_abs_difference(h264.frame(), served) < 3.0; }, 10s));
+    CHECK(tight.pump_until([&] { return rfbsim::test::mean_abs_difference(tight.frame(), served) < 3.0; }, 10s));
+  }
+  REQUIRE(eventually([&] { return encoding_of(server, 1) == "h264" && encoding_of(server, 2) == "tight"; }, 5s));
+}
+
+TEST_CASE("with codec jpeg, a client that offers H.264 still gets Tight", "[streaming][h264]") {
+  rfbsim::Server server(h264_server(rfbsim::Codec::kJpeg));
+  rfbsim::test::H264RfbClientOptions options;
+  options.offer_tight = true;
+  H264RfbClient client("127.0.0.1", server.port(), options);
+  submit(server, picture(0));
+  // This client cannot decode Tight: pump_until throws on the first Tight rectangle, as it should here.
+  CHECK_THROWS_WITH(client.pump_until([] { return false; }, 5s), Catch::Contains("Tight"));
+  CHECK(client.h264_pictures() == 0);
+}
