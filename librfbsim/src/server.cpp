@@ -7,10 +7,6 @@
 // encoded while it is being written (no tearing), and the simulation thread only ever touches the mailbox.
 #include "rfbsim/server.hpp"
 
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
 #include <poll.h>
 #include <rfb/rfb.h>
 #include <linux/sockios.h>
@@ -32,16 +28,9 @@
 #include <thread>
 #include <utility>
 
-#include "call_watchdog.hpp"
 #include "client_state.hpp"
-#include "frame_mailbox.hpp"
-#include "held_keys.hpp"
-#include "http_request.hpp"
-#include "http_service.hpp"
-#include "listener.hpp"
-#include "proxy_header.hpp"
 #include "rfb_extension.hpp"
-#include "rfbsim/tile_damage.hpp"
+#include "server_impl.hpp"
 
 namespace rfbsim {
 
@@ -49,12 +38,6 @@ using detail::ClientState;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-// How long a silent new connection may take to show whether it speaks HTTP. Raw RFB clients wait for the
-// server to speak first, so they are only recognised by this timeout; browsers send their request at once.
-// A server with nothing to serve over HTTP skips this wait (see Impl::serves_http).
-constexpr auto kSniffTimeout = std::chrono::milliseconds(500);
 // Poll timeout when nothing is pending; only bounds how fast the thread notices a stop request.
 constexpr int kIdlePollMs = 200;
 // Poll timeout while a client's output is backed up: how often we look whether it has drained.
@@ -63,9 +46,6 @@ constexpr int kBackedUpPollMs = 5;
 // are still unsent in its socket. A client on a slow link then gets fewer, always current, frames instead
 // of a growing backlog, and writing its updates never blocks the thread that serves everyone.
 constexpr int kMaxUnsentBytes = 128 * 1024;
-// Asked-for socket send buffer (the kernel caps it at twice net.core.wmem_max): room for one whole update
-// on top of kMaxUnsentBytes, so that starting an update does not block either.
-constexpr int kSendBufferBytes = 1024 * 1024;
 
 // libvncserver's log goes through these global hooks; keep its chatter off unless asked for.
 bool vnc_log_enabled() {
@@ -81,7 +61,6 @@ void vnc_log(const char* format, ...) {
   va_end(args);
 }
 
-// libvncserver's index of Tight subsampling levels: 0 = 4:4:4, 1 = 4:2:0, 2 = 4:2:2, 3 = grey.
 // Bytes written to a socket that the peer has not yet acknowledged (TCP) or read.
 int unsent_bytes(int fd) {
   int queued = 0;
@@ -89,6 +68,7 @@ int unsent_bytes(int fd) {
   return queued;
 }
 
+// libvncserver's index of Tight subsampling levels: 0 = 4:4:4, 1 = 4:2:0, 2 = 4:2:2, 3 = grey.
 int turbo_subsampling_index(Subsampling s) {
   switch (s) {
     case Subsampling::k444: return 0;
@@ -97,19 +77,6 @@ int turbo_subsampling_index(Subsampling s) {
     case Subsampling::kGray: return 3;
   }
   return 1;
-}
-
-std::string peer_address(int fd) {
-  sockaddr_storage peer{};
-  socklen_t length = sizeof peer;
-  if (::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &length) != 0) return "?";
-  char text[INET6_ADDRSTRLEN] = {};
-  if (peer.ss_family == AF_INET6) {
-    ::inet_ntop(AF_INET6, &reinterpret_cast<sockaddr_in6*>(&peer)->sin6_addr, text, sizeof text);
-  } else {
-    ::inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(&peer)->sin_addr, text, sizeof text);
-  }
-  return text;
 }
 
 ServerOptions validated(ServerOptions o) {
@@ -135,78 +102,6 @@ ServerOptions validated(ServerOptions o) {
 }
 
 }  // namespace
-
-// A connection accepted but not yet known to be HTTP, WebSocket or raw RFB.
-struct PendingConnection {
-  int fd = -1;
-  Clock::time_point accepted{};
-  bool proxied = false;   // its PROXY line was read (or none is expected)
-  std::string address;    // from the PROXY line; "" = the socket's peer
-};
-
-struct Server::Impl {
-  explicit Impl(ServerOptions o);
-  ~Impl();
-
-  void run();
-  void accept_new();
-  void classify_pending();
-  // Hands a connection to libvncserver; `address` (from a PROXY line) replaces the socket's peer if given.
-  void adopt_rfb(int fd, const std::string& address = "");
-  // Reads a pending connection's PROXY line once it is whole. False: close the connection (no valid line).
-  bool take_proxy_header(PendingConnection& connection, std::string_view bytes, Clock::time_point now);
-  void apply_newest_frame();
-  void serve_clients(const std::vector<pollfd>& polled);
-  bool may_send_update(rfbClientPtr cl, Clock::time_point now);
-  int poll_timeout_ms() const;
-
-  // libvncserver hooks (C function pointers); `self` comes from screen->screenData.
-  static Impl& of(rfbClientPtr cl) { return *static_cast<Impl*>(cl->screen->screenData); }
-  static rfbNewClientAction on_new_client(rfbClientPtr cl);
-  static void on_client_gone(rfbClientPtr cl);
-  static void on_key(rfbBool down, rfbKeySym keysym, rfbClientPtr cl);
-  static void on_pointer(int mask, int x, int y, rfbClientPtr cl);
-  static void on_update_start(rfbClientPtr cl);
-  static void on_update_done(rfbClientPtr cl, int result);
-  static void on_update_request(rfbClientPtr cl, rfbFramebufferUpdateRequestMsg* request);
-  void publish_streams(Clock::time_point now);
-
-  ServerOptions options;
-  // Whether plain HTTP has anything to get here (a web root or a json route). Without it every new
-  // connection goes to libvncserver at once: sniffing would only delay raw RFB clients by kSniffTimeout.
-  bool serves_http = false;
-  detail::Listener listener;
-  int wake_fd = -1;
-  rfbScreenInfoPtr screen = nullptr;
-  std::vector<std::uint8_t> framebuffer;  // what clients see; written only by the network thread
-  std::vector<std::uint8_t> incoming;     // the frame taken from the mailbox
-  detail::FrameMailbox mailbox;
-  TileDamage damage;
-  InputQueue input;
-  detail::HeldKeys held_keys;             // network thread only
-  std::vector<PendingConnection> pending; // network thread only
-  std::unique_ptr<detail::HttpService> http;
-  detail::CallWatchdog watchdog;          // cuts off a client that blocks the network thread
-  int adopting_guard_fd = -1;             // handed from adopt_rfb to on_new_client
-  std::string adopting_address;           // handed from adopt_rfb to on_new_client; "" = the socket's peer
-  bool any_backed_up = false;             // some client's output is above kMaxUnsentBytes
-  detail::StreamerConfig streamer_config;  // what each client's ClientStreamer starts from
-  Clock::time_point streams_published{};  // when `streams` was last refreshed
-  mutable std::mutex streams_mutex;        // guards `streams` (read from any thread)
-  std::vector<ClientStreamStatus> streams;
-  int next_client_id = 1;
-
-  std::atomic<bool> stopping{false};
-  std::atomic<int> clients{0};
-  std::atomic<std::uint64_t> frames_submitted{0};
-  std::atomic<std::uint64_t> frames_applied{0};
-  std::atomic<std::uint64_t> tiles_changed{0};
-  std::atomic<std::uint64_t> updates_sent{0};
-  std::atomic<std::uint64_t> bytes_sent{0};
-  std::atomic<std::uint64_t> encode_ns{0};
-  std::atomic<std::uint64_t> backed_up_drops{0};
-  std::thread thread;
-};
 
 Server::Impl::Impl(ServerOptions o)
     : options(validated(std::move(o))),
@@ -411,115 +306,6 @@ bool Server::Impl::may_send_update(rfbClientPtr cl, Clock::time_point now) {
   return false;
 }
 
-void Server::Impl::accept_new() {
-  for (;;) {
-    const int fd = ::accept4(listener.fd, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
-    if (fd < 0) return;  // EAGAIN: no more; other errors (EMFILE...) are retried on the next wake
-    // Nothing HTTP to serve: whatever the peer speaks is libvncserver's to take (RFB, RFB over WebSocket)
-    // or to refuse (a plain HTTP request, garbage), as if it owned the port.
-    if (!serves_http && !options.proxy_protocol) {
-      adopt_rfb(fd);
-      continue;
-    }
-    pending.push_back({fd, Clock::now(), !options.proxy_protocol, ""});
-  }
-}
-
-void Server::Impl::classify_pending() {
-  const auto now = Clock::now();
-  for (auto it = pending.begin(); it != pending.end();) {
-    char peeked[detail::kMaxHttpHeadBytes + 1];
-    const auto n = ::recv(it->fd, peeked, sizeof peeked, MSG_PEEK | MSG_DONTWAIT);
-    if (n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) {
-      ::close(it->fd);  // left before saying anything
-      it = pending.erase(it);
-      continue;
-    }
-    const std::string_view bytes(peeked, n > 0 ? static_cast<std::size_t>(n) : 0U);
-    if (!it->proxied) {
-      if (!take_proxy_header(*it, bytes, now)) {
-        ::close(it->fd);
-        it = pending.erase(it);
-        continue;
-      }
-      if (!it->proxied) {
-        ++it;  // the line is still coming
-        continue;
-      }
-      if (!serves_http) {
-        adopt_rfb(it->fd, it->address);
-        it = pending.erase(it);
-        continue;
-      }
-      ++it;  // sniff the client's own bytes at the next wake
-      continue;
-    }
-    auto protocol = detail::sniff_protocol(bytes);
-    if (protocol == detail::WireProtocol::Undecided && now - it->accepted >= kSniffTimeout) {
-      // Silence means a raw RFB client waiting for our greeting; a half-sent HTTP head gets its error.
-      protocol = bytes.empty() ? detail::WireProtocol::Rfb : detail::WireProtocol::Http;
-    }
-    switch (protocol) {
-      case detail::WireProtocol::Undecided:
-        ++it;
-        continue;
-      case detail::WireProtocol::Rfb:
-      case detail::WireProtocol::WebSocket:
-        adopt_rfb(it->fd, it->address);
-        break;
-      case detail::WireProtocol::Http:
-        http->serve(it->fd);
-        break;
-    }
-    it = pending.erase(it);
-  }
-}
-
-bool Server::Impl::take_proxy_header(PendingConnection& connection, std::string_view bytes, Clock::time_point now) {
-  const detail::ProxyHeader header = detail::parse_proxy_header(bytes);
-  switch (header.status) {
-    case detail::ProxyHeader::Status::Incomplete:
-      if (now - connection.accepted < options.read_timeout) return true;
-      std::fprintf(stderr, "[rfbsim.server] closing a connection: no PROXY line within %lld ms\n",
-                   static_cast<long long>(options.read_timeout.count()));
-      return false;
-    case detail::ProxyHeader::Status::Invalid:
-      std::fprintf(stderr, "[rfbsim.server] closing a connection: it did not begin with a PROXY line\n");
-      return false;
-    case detail::ProxyHeader::Status::Valid: break;
-  }
-  // Consume exactly the line: what follows is the client's own.
-  char line[detail::kMaxProxyHeaderBytes];
-  const auto n = ::recv(connection.fd, line, header.length, MSG_DONTWAIT);
-  if (n != static_cast<ssize_t>(header.length)) return false;
-  connection.proxied = true;
-  connection.address = header.source;
-  connection.accepted = now;  // the sniff's clock starts with the client's own bytes
-  return true;
-}
-
-void Server::Impl::adopt_rfb(int fd, const std::string& address) {
-  const int one = 1;
-  ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-  ::setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &kSendBufferBytes, sizeof kSendBufferBytes);
-  // libvncserver takes the socket over: it runs the WebSocket handshake if there is one (under the
-  // watchdog, so a handshake sent byte by byte cannot hold the thread), then RFB. On failure it closes
-  // the socket itself; our duplicate keeps the watchdog's descriptor valid meanwhile.
-  const int guard = ::fcntl(fd, F_DUPFD_CLOEXEC, 0);
-  if (guard < 0) {
-    std::fprintf(stderr, "[rfbsim.server] refusing a client: out of file descriptors\n");
-    ::close(fd);
-    return;
-  }
-  adopting_guard_fd = guard;
-  adopting_address = address;
-  watchdog.arm(guard, Clock::now() + options.read_timeout);
-  rfbNewClient(screen, fd);
-  watchdog.disarm();
-  // on_new_client takes the duplicate when it accepts the client; otherwise it is ours to close.
-  if (adopting_guard_fd >= 0) ::close(std::exchange(adopting_guard_fd, -1));
-}
-
 void Server::Impl::apply_newest_frame() {
   if (!mailbox.take(incoming)) return;
   const FrameView current{framebuffer.data(), options.width, options.height, 0};
@@ -558,120 +344,6 @@ void Server::Impl::publish_streams(Clock::time_point now) {
   const std::lock_guard lock(streams_mutex);
   streams = std::move(fresh);
 }
-
-rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
-  Impl& self = of(cl);
-  // Set before refusing too: refused clients also pass through the hook (see on_client_gone).
-  cl->clientGoneHook = on_client_gone;
-  if (self.clients.load() >= self.options.max_clients) {
-    std::fprintf(stderr, "[rfbsim.server] refusing a client: %d of %d already connected\n", self.clients.load(),
-                 self.options.max_clients);
-    return RFB_CLIENT_REFUSE;
-  }
-  auto* state = new ClientState(self.streamer_config);
-  state->info.id = self.next_client_id++;
-  state->info.address = self.adopting_address.empty() ? peer_address(cl->sock) : self.adopting_address;
-  state->info.websocket = cl->wsctx != nullptr;
-  state->guard_fd = std::exchange(self.adopting_guard_fd, -1);
-  cl->clientData = state;
-  cl->clientFramebufferUpdateRequestHook = on_update_request;
-  cl->viewOnly = self.options.view_only ? TRUE : FALSE;
-  ++self.clients;
-  if (self.options.on_connect) self.options.on_connect(state->info);
-  return RFB_CLIENT_ACCEPT;
-}
-
-void Server::Impl::on_client_gone(rfbClientPtr cl) {
-  Impl& self = of(cl);
-#if RFBSIM_LIBVNCSERVER_LEAKS_WSCTX
-  // libvncserver up to 0.9.14 never frees a WebSocket client's context (about 46 KB a connection;
-  // LibVNC/libvncserver#571, fixed after 0.9.14). Nothing reads it after this hook.
-  std::free(cl->wsctx);
-  cl->wsctx = nullptr;
-#endif
-  auto* state = static_cast<ClientState*>(cl->clientData);
-  if (state == nullptr) return;
-  cl->clientData = nullptr;
-  self.watchdog.forget(state->guard_fd);
-  ::close(state->guard_fd);
-  const int remaining = --self.clients;
-  // Keys this client held would otherwise stay down forever in the simulation.
-  const auto now = Clock::now();
-  for (const auto& release : self.held_keys.release_client(state->info.id, now)) self.input.push(release);
-  if (remaining == 0) {
-    for (const auto& release : self.held_keys.release_all(now)) self.input.push(release);
-  }
-  if (self.options.on_disconnect) self.options.on_disconnect(state->info);
-  delete state;
-}
-
-void Server::Impl::on_key(rfbBool down, rfbKeySym keysym, rfbClientPtr cl) {
-  Impl& self = of(cl);
-  const auto* state = static_cast<ClientState*>(cl->clientData);
-  if (self.options.view_only || state == nullptr) return;
-  InputEvent event;
-  event.kind = InputEvent::Kind::Key;
-  event.time = Clock::now();
-  event.client_id = state->info.id;
-  event.keysym = keysym;
-  event.down = down != 0;
-  self.held_keys.record(event);
-  self.input.push(event);
-}
-
-void Server::Impl::on_pointer(int mask, int x, int y, rfbClientPtr cl) {
-  Impl& self = of(cl);
-  const auto* state = static_cast<ClientState*>(cl->clientData);
-  if (self.options.view_only || state == nullptr) return;
-  InputEvent event;
-  event.kind = InputEvent::Kind::Pointer;
-  event.time = Clock::now();
-  event.client_id = state->info.id;
-  event.x = x;
-  event.y = y;
-  event.buttons = static_cast<std::uint8_t>(mask);
-  self.input.push(event);
-}
-
-void Server::Impl::on_update_start(rfbClientPtr cl) {
-  auto* state = static_cast<ClientState*>(cl->clientData);
-  if (state == nullptr) return;
-  state->update_started = Clock::now();
-  state->bytes_before_update = rfbStatGetSentBytes(cl);
-  // Impose the server's JPEG quality and subsampling on Tight clients, whatever level they asked for;
-  // the client's streamer lowers it while its link cannot carry the frame rate.
-  if (const auto level = state->streamer.tight_quality()) {
-    cl->turboQualityLevel = level->jpeg_quality;
-    cl->turboSubsampLevel = level->subsampling;
-    cl->tightQualityLevel = std::min(9, level->jpeg_quality / 10);
-  }
-}
-
-void Server::Impl::on_update_request(rfbClientPtr cl, rfbFramebufferUpdateRequestMsg* request) {
-  // A full (non-incremental) request means the client lost its picture: H.264 restarts with an IDR.
-  auto* state = static_cast<ClientState*>(cl->clientData);
-  if (state == nullptr) return;
-  ++state->streamer.protocol().update_requests;
-  if (request->incremental == 0) state->streamer.protocol().full_update_requested = true;
-}
-
-void Server::Impl::on_update_done(rfbClientPtr cl, int /*result*/) {
-  Impl& self = of(cl);
-  auto* state = static_cast<ClientState*>(cl->clientData);
-  if (state == nullptr) return;
-  // libvncserver's byte counter is an int that wraps after 2 GiB: subtract as unsigned 32-bit.
-  const std::uint32_t sent = static_cast<std::uint32_t>(rfbStatGetSentBytes(cl)) -
-                             static_cast<std::uint32_t>(state->bytes_before_update);
-  // The hook also runs when libvncserver found nothing to send; that is no update.
-  if (sent == 0) return;
-  const auto now = Clock::now();
-  const auto elapsed = now - state->update_started;
-  state->streamer.tight_update_written(now, sent);
-  self.encode_ns += static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(elapsed).count());
-  self.bytes_sent += sent;
-  ++self.updates_sent;
-}
-
 Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
 Server::~Server() = default;
 
@@ -723,3 +395,4 @@ std::vector<ClientStreamStatus> Server::client_streams() const {
 const ServerOptions& Server::options() const { return impl_->options; }
 
 }  // namespace rfbsim
+

@@ -4,6 +4,7 @@
 // answered as rfbproto says, and the server keeps serving the others.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <vector>
@@ -41,10 +42,11 @@ std::vector<std::uint8_t> enable_continuous(bool enable, int x, int y, int w, in
 }
 
 std::vector<std::uint8_t> fence(std::uint32_t flags, const std::vector<std::uint8_t>& payload) {
-  std::vector<std::uint8_t> out{248, 0, 0, 0, static_cast<std::uint8_t>(flags >> 24),
-                                static_cast<std::uint8_t>(flags >> 16), static_cast<std::uint8_t>(flags >> 8),
-                                static_cast<std::uint8_t>(flags), static_cast<std::uint8_t>(payload.size())};
-  out.insert(out.end(), payload.begin(), payload.end());
+  std::vector<std::uint8_t> out(9 + payload.size());
+  out[0] = 248;  // then 3 padding bytes
+  for (int i = 0; i < 4; ++i) out[4 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(flags >> (24 - 8 * i));
+  out[8] = static_cast<std::uint8_t>(payload.size());
+  std::copy(payload.begin(), payload.end(), out.begin() + 9);
   return out;
 }
 
