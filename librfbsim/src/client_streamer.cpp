@@ -51,14 +51,19 @@ void add_rect(sraRegionPtr region, const PixelRect& r) {
   sraRgnDestroy(rect);
 }
 
-}  // namespace
+// Whether the picture itself has changes to send. libvncserver's FB_UPDATE_PENDING also counts cursor and
+// desktop-size news, which only its own updates deliver (and clear): an H.264 stream, which never sends
+// them, would otherwise look due on every pass.
+bool picture_changed(rfbClientPtr client) {
+  return !sraRgnEmpty(client->modifiedRegion) || !sraRgnEmpty(client->copyRegion);
+}
 
-namespace {
 AdaptiveQualityConfig quality_config(const StreamerConfig& config) {
   AdaptiveQualityConfig c;
   c.top_quality = config.jpeg_quality > 0 ? config.jpeg_quality : 80;
   return c;
 }
+
 }  // namespace
 
 ClientStreamer::ClientStreamer(const StreamerConfig& config) : config_(config), quality_(quality_config(config)) {}
@@ -102,7 +107,8 @@ ClientStreamer::Sent ClientStreamer::serve(rfbClientPtr client, TimePoint now, c
     add_rect(client->modifiedRegion, {0, 0, config_.width, config_.height});
     still_refresh_ = true;
   }
-  if (!FB_UPDATE_PENDING(client)) return sent;
+  const bool h264 = use_h264();
+  if (!(h264 ? picture_changed(client) : FB_UPDATE_PENDING(client))) return sent;
   if (pushed) {
     UpdateLock lock(client);
     if (congestion_.is_congested(now)) {
@@ -122,7 +128,7 @@ ClientStreamer::Sent ClientStreamer::serve(rfbClientPtr client, TimePoint now, c
     return sent;  // a requesting client that has not asked yet
   }
 
-  if (use_h264()) {
+  if (h264) {
     sent = send_h264(client, now, framebuffer);
   } else {
     sent.update = rfbUpdateClient(client) != FALSE;
