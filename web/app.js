@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // rfbsim participant page logic: connects noVNC to this session's simulator and keeps hints and messages in step.
 
+import { installH264Guard } from './h264_guard.js';
 import RFB from './novnc/core/rfb.js';
 import { SurveyReporter } from './survey.js';
 
@@ -35,6 +36,12 @@ const state = {
   firstFrameAt: null,     // ms since the navigation started (performance.now()) when a picture was first drawn
   sessionState: null,     // the manager's last word on this session ('starting', 'running', 'ended', ...), or
                           // null where no manager answers (sim_rfb serving the page itself)
+  h264Guarded: false,     // the H.264 guard is installed (the browser has WebCodecs' VideoDecoder)
+  h264Offered: null,      // the last connection offered H.264 (encoding 50); null before one sent its encodings
+  h264Disabled: false,    // H.264 failed too often here: later connections offer JPEG only
+  recovering: false,      // a picture could not be decoded and the connection is being replaced
+  pictureFailures: 0,     // pictures this page could not decode (each replaced its connection)
+  lastPictureFailure: null,  // { reason, detail, at (performance.now()) } of the last one
 };
 window.rfbsimState = state;
 
@@ -212,6 +219,11 @@ function showStatus(text, counter = '') {
 // The progress line for where the current attempt stands: starting (with the manager's clock), connecting,
 // loading the first picture, or nothing once the picture shows.
 function showProgress() {
+  if (state.recovering) {
+    const waited = performance.now() - recoveringSince;
+    showStatus(waited >= RECOVERY_NOTICE_MS ? 'Restoring the picture\u2026' : '');
+    return;
+  }
   if (state.connected) {
     showStatus(pictureShown ? '' : 'Loading the picture\u2026');
   } else if (state.connecting) {
@@ -281,12 +293,108 @@ function watchForFirstPicture(client, view) {
 
 function firstPictureShown() {
   pictureShown = true;
+  if (state.recovering) {
+    endRecovery();
+  }
   if (state.firstFrameAt === null) {
     state.firstFrameAt = performance.now();
   }
   survey.started();
   showProgress();
   startStatusPolling();
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// A picture the browser could not decode (H.264 only, see h264_guard.js): noVNC 1.7 would wait for it forever, so
+// the connection is replaced without a word. A new connection gets a new decoder, and the server starts its stream
+// with a whole picture (an IDR). Meanwhile the frozen picture stays on screen, and if no new one shows within
+// RECOVERY_NOTICE_MS the progress line says that it is being restored. Failures that follow one another wait longer
+// each time (RECOVERY_BACKOFF_MS), so that a browser that fails on every picture never reconnects in a tight loop;
+// after H264_FAILURES_BEFORE_JPEG of them the page stops offering H.264 and the server streams JPEG instead.
+// ---------------------------------------------------------------------------------------------------------------
+// Wait before the 1st, 2nd and 3rd reconnect in a row; the 3rd is the last one H.264 gets (the page then asks for
+// JPEG, which needs no decoder), the last wait stands for any later one.
+const RECOVERY_BACKOFF_MS = [0, 1000, 3000];
+const RECOVERY_CALM_MS = 60_000;     // a failure this long after the last one starts a new series
+const RECOVERY_NOTICE_MS = 2000;     // without a picture for this long, the participant is told
+const H264_FAILURES_BEFORE_JPEG = 3; // failures in one series after which H.264 is no longer offered
+const H264_ENCODING = 50;            // RFB encoding number of H.264 rectangles
+
+let recovery = null;           // { delayMs, focus } from a failure until its connection has closed
+let recoveringSince = 0;       // performance.now() of the failure being recovered from
+let recoveryNoticeTimer = null;
+let failuresInARow = 0;        // failures in the current series
+let lastFailureAt = -Infinity; // performance.now() of the last failure
+let heldPicture = false;       // #screen's background shows the frozen picture
+
+const h264Guard = installH264Guard({ onFailure: pictureFailed });
+state.h264Guarded = h264Guard.installed;
+
+// noVNC offers H.264 whenever the browser can decode it and has no option to stop; once H.264 is given up here,
+// its encodings message (sent on every connection) goes out without encoding 50.
+const writeClientEncodings = RFB.messages.clientEncodings;
+RFB.messages.clientEncodings = function clientEncodings(sock, encodings) {
+  const offered = state.h264Disabled ? encodings.filter((encoding) => encoding !== H264_ENCODING) : encodings;
+  state.h264Offered = offered.includes(H264_ENCODING);
+  return writeClientEncodings.call(this, sock, offered);
+};
+
+// The guard's report: replace the current connection (its 'disconnect' reaches finishAttempt, which reconnects).
+function pictureFailed({ reason, detail }) {
+  if (rfb === null || recovery !== null) {
+    return;   // no connection to replace, or one already on its way out
+  }
+  const now = performance.now();
+  failuresInARow = now - lastFailureAt > RECOVERY_CALM_MS ? 1 : failuresInARow + 1;
+  lastFailureAt = now;
+  state.pictureFailures += 1;
+  state.lastPictureFailure = { reason, detail, at: now };
+  console.warn(`rfbsim: the picture could not be decoded (${detail}); reconnecting`);
+  if (failuresInARow >= H264_FAILURES_BEFORE_JPEG && !state.h264Disabled) {
+    state.h264Disabled = true;
+    console.warn(`rfbsim: H.264 failed ${failuresInARow} times in a row; asking for JPEG from now on`);
+  }
+
+  // The view's keyboard focus is noted now: noVNC's disconnect takes the canvas away, and the focus with it.
+  recovery = {
+    delayMs: RECOVERY_BACKOFF_MS[Math.min(failuresInARow, RECOVERY_BACKOFF_MS.length) - 1],
+    focus: state.focused,
+  };
+  state.recovering = true;
+  recoveringSince = now;
+  clearTimeout(recoveryNoticeTimer);
+  recoveryNoticeTimer = setTimeout(showProgress, RECOVERY_NOTICE_MS);
+  holdPicture(canvas);
+  rfb.disconnect();
+}
+
+// Keeps a still copy of the frozen picture behind noVNC's (transparent, see connect) view until the new connection
+// draws its first picture; 'contain' letterboxes it the way noVNC's scaleViewport does.
+function holdPicture(view) {
+  if (view === null || view.width === 0 || view.height === 0) {
+    return;
+  }
+  try {
+    const url = view.toDataURL('image/jpeg', 0.9);
+    ui.screen.style.background = `#1e1e1e url("${url}") center / contain no-repeat`;
+    heldPicture = true;
+  } catch (err) {
+    console.warn('rfbsim: could not keep the last picture on screen:', err);
+  }
+}
+
+// The recovery is over: a new picture shows, or the page says why there is none.
+function endRecovery() {
+  state.recovering = false;
+  clearTimeout(recoveryNoticeTimer);
+  recoveryNoticeTimer = null;
+  if (heldPicture) {
+    ui.screen.style.background = '';
+    heldPicture = false;
+  }
+  if (rfb !== null) {
+    rfb.background = '#1e1e1e';
+  }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -338,7 +446,8 @@ function connect({ focusWhenConnected = false } = {}) {
   client.focusOnClick = true;
   client.showDotCursor = true;
   client.viewOnly = watching;
-  client.background = '#1e1e1e';
+  // While a frozen picture is held behind the view (see holdPicture), the view lets it show until it has its own.
+  client.background = state.recovering ? 'transparent' : '#1e1e1e';
   if (options.quality !== null) {
     client.qualityLevel = options.quality;
   }
@@ -410,6 +519,8 @@ async function finishAttempt(info) {
     canvas.removeEventListener('focus', updateFocus);
     canvas.removeEventListener('blur', updateFocus);
   }
+  // The connection's decoders are gone with it: nothing they do from now on is a failure of the next one.
+  h264Guard.retire();
   rfb = null;
   canvas = null;
   state.connecting = false;
@@ -428,10 +539,22 @@ async function finishAttempt(info) {
       message += ` Your completion code: ${state.completionCode}`;
     }
     survey.ended();
+    recovery = null;
+    endRecovery();
     state.lastDisconnect = { ...info, kind: 'ended', final: true, sessionState: session.state, message };
     showDisconnected('Session ended', message, true);
     return;
   }
+
+  // A connection replaced after a picture failure: connect again, quietly, after the series' wait.
+  if (recovery !== null) {
+    const { delayMs, focus } = recovery;
+    recovery = null;
+    showProgress();
+    setTimeout(() => connect({ focusWhenConnected: focus }), delayMs);
+    return;
+  }
+  endRecovery();
 
   let title;
   let message;
