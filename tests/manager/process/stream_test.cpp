@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "manager_process.hpp"
+#include "h264_rfb_client.hpp"
 #include "rfb_test_client.hpp"
 #include "ws_rfb_bridge.hpp"
 
@@ -145,4 +146,53 @@ TEST_CASE("the configured codec reaches sim_rfb's command line", "[manager]") {
   WsRfbBridge bridge(manager.ws_url(token));
   RfbTestClient client("127.0.0.1", bridge.port());
   CHECK(client.wait_for_updates(1, 20s));
+}
+
+TEST_CASE("ContinuousUpdates and fences pass the relay unchanged, and the round trip is measured through it",
+          "[manager][streaming]") {
+  TempDir data;
+  ManagerUnderTest manager(data.path(), with_small_sessions({"--scenarios", "lab", "--admin-token", kAdminToken,
+                                                             "--codec", "jpeg"}));
+  const std::string token = token_from_redirect(manager.start("uid=stream-cu&scenario=lab"));
+  REQUIRE(manager.wait_for_state(token, "running"));
+  WsRfbBridge bridge(manager.ws_url(token));
+  RfbTestClient client("127.0.0.1", bridge.port(), 8, rfbsim::test::UpdateMode::kContinuous);
+  REQUIRE(client.pump_until([&] { return client.continuous(); }, 20s));
+  client.send_key('d', true);  // turning: the picture keeps changing
+  const std::uint64_t before = client.updates();
+  // No request is sent from here on: every update is pushed through the relay, each followed by a ping.
+  CHECK(client.wait_for_updates(20, 30s));
+  CHECK(client.updates() >= before + 20);
+  CHECK(client.fences_answered() >= 20);
+  CHECK(client.bad_fences() == 0);
+  CHECK(client.end_of_continuous_updates() == 1);
+  nlohmann::json session;
+  REQUIRE(await_session(manager, token, &client, [](const nlohmann::json& s) {
+    return s["codec"] == "tight" && s["rtt_ms"].is_number();
+  }, session));
+  INFO(session.dump());
+  CHECK(session["rtt_ms"].get<double>() >= 0.0);
+  client.send_key('d', false);
+}
+
+TEST_CASE("H.264 pictures pass the relay and decode", "[manager][streaming]") {
+  TempDir data;
+  ManagerUnderTest manager(data.path(), with_small_sessions({"--scenarios", "lab", "--admin-token", kAdminToken,
+                                                             "--codec", "h264"}));
+  const std::string token = token_from_redirect(manager.start("uid=stream-h264&scenario=lab"));
+  REQUIRE(manager.wait_for_state(token, "running"));
+  WsRfbBridge bridge(manager.ws_url(token));
+  rfbsim::test::H264RfbClient client("127.0.0.1", bridge.port());
+  client.send_key('d', true);
+  CHECK(client.wait_for_updates(10, 30s));
+  CHECK(client.h264_pictures() >= 10);
+  CHECK(client.idr_pictures() >= 1);
+  CHECK(client.decode_errors() == 0);
+  CHECK(client.continuous());
+  nlohmann::json session;
+  REQUIRE(await_session(manager, token, nullptr, [&](const nlohmann::json& s) {
+    client.pump_until([] { return false; }, 100ms);
+    return s["codec"] == "h264";
+  }, session));
+  client.send_key('d', false);
 }
