@@ -8,6 +8,7 @@ extern "C" {
 #include <rfb/rfbregion.h>
 }
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 #include <utility>
@@ -24,6 +25,8 @@ constexpr std::uint8_t kPingPayload[] = {'p'};
 constexpr std::uint64_t kPingBytes = 9 + sizeof kPingPayload;
 // H.264's rate cap from the link's measured rate: leave room for the fences, input echo and jitter.
 constexpr double kH264ShareOfLink = 0.8;
+// How long after the last held picture the H.264 stream stays capped at the link's rate.
+constexpr auto kH264CapHold = std::chrono::seconds(5);
 
 // libvncserver's regions are guarded by updateMutex (its FBUR handler takes it too).
 class UpdateLock {
@@ -116,6 +119,8 @@ ClientStreamer::Sent ClientStreamer::serve(rfbClientPtr client, TimePoint now, c
       // incremental request must not slip an update past the window, so the requested area is dropped.
       if (fresh) {
         ++updates_held_;
+        // Holds while the window is still opening say nothing about the link.
+        if (!congestion_.in_slow_start()) last_hold_ = now;
         offer_frame(now, true);
       }
       sraRgnMakeEmpty(client->requestedRegion);
@@ -158,7 +163,7 @@ void ClientStreamer::offer_frame(TimePoint now, bool held) {
   if (!config_.adaptive_quality) return;
   // While the window is still in slow start, a held frame says the window is small, not the link slow.
   quality_.frame_offered(now, held && !congestion_.in_slow_start());
-  quality_.adjust(now, congestion_.delivery_rate());
+  quality_.adjust(now, congestion_.path_rate());
 }
 
 void ClientStreamer::tight_update_written(TimePoint now, std::uint64_t bytes) {
@@ -196,8 +201,13 @@ ClientStreamer::Sent ClientStreamer::send_h264(rfbClientPtr client, TimePoint no
   // A new decoder (first picture) or a full request (the client lost its picture) needs an IDR.
   const bool asked = std::exchange(protocol_.full_update_requested, false);
   const bool idr = first || asked;
+  // Capped only while the link is what holds pictures back, at the rate the client then received (the
+  // link's, since it was full). A cap drawn from a stream that fits the link easily would measure only
+  // our own pace, and each picture made smaller by it would lower the next cap: it would only ever fall.
   const double rate = congestion_.delivery_rate();
-  encoder_->set_max_bitrate(rate > 0 ? static_cast<int>(rate * 8.0 * kH264ShareOfLink) : 0);
+  const bool link_bound = last_hold_ && now - *last_hold_ < kH264CapHold;
+  encoder_->set_max_bitrate(link_bound && rate > 0 ? static_cast<int>(std::min(rate * 8.0 * kH264ShareOfLink, 2e9))
+                                                   : 0);
   const auto started = Clock::now();
   std::vector<std::uint8_t> picture;
   try {
@@ -269,7 +279,7 @@ ClientStreamStatus ClientStreamer::status(int id, TimePoint now) const {
   const auto level = tight_quality();
   s.quality = level ? level->jpeg_quality : 0;
   s.quality_level = protocol_.continuous && config_.adaptive_quality ? static_cast<int>(quality_.level()) : 0;
-  s.delivery_mbit = congestion_.delivery_rate() * 8.0 / 1e6;
+  s.delivery_mbit = congestion_.path_rate() * 8.0 / 1e6;
   // An fps that stopped being refreshed (no updates for a while) is stale: age it out.
   s.fps = now - rate_window_start_ > std::chrono::seconds(2) ? 0.0 : fps_;
   return s;

@@ -89,6 +89,7 @@ class ClientStreamer {
   bool still_refresh_ = false;            // the next Tight update is the still picture at top quality
   std::uint64_t updates_sent_ = 0;
   std::uint64_t updates_held_ = 0;
+  std::optional<TimePoint> last_hold_;    // when congestion last held a new frame back
   TimePoint rate_window_start_{};
   std::uint64_t rate_window_updates_ = 0;
   double fps_ = 0;

@@ -23,6 +23,9 @@ constexpr std::uint32_t kSlowStep = 4 * 1024;
 constexpr auto kIdleMin = 100ms;              // idle longer than this and 2 x baseRTT restarts
 constexpr auto kRateSpan = 100ms;             // one delivery-rate sample spans at least this
 constexpr double kRateGain = 0.25;            // weight of a new sample in the smoothed rate
+constexpr std::uint64_t kMinPathBurst = 2048;  // smaller updates arrive too fast to time
+constexpr auto kMinPathSpread = 200us;        // ... and so do answers closer together than this
+constexpr std::size_t kPathSamples = 9;       // the path rate is the median of this many samples
 
 std::uint32_t clamp_window(std::int64_t bytes) {
   return static_cast<std::uint32_t>(std::clamp<std::int64_t>(bytes, CongestionControl::kMinWindow,
@@ -51,7 +54,8 @@ void CongestionControl::sent_ping(TimePoint now, std::uint64_t position) {
   update_position(now, position);
   // A ping that leaves the window full means the next update has to wait: the window is the limit,
   // and only then does the answer say anything about whether the window could be larger.
-  pings_.push_back({now, position, in_flight(now) >= window_});
+  pings_.push_back({now, position, position - last_ping_position_, in_flight(now) >= window_});
+  last_ping_position_ = position;
 }
 
 bool CongestionControl::got_pong(TimePoint now) {
@@ -67,10 +71,16 @@ bool CongestionControl::got_pong(TimePoint now) {
   last_rtt_ = rtt;
   if (!base_rtt_ || rtt < *base_rtt_) base_rtt_ = rtt;
   sample_rate(now, ping, rtt);
+  sample_path_rate(now, ping);
+
+  // Both the base and each measurement leave out the update's own time on the path, so that a big
+  // update on a slow link, alone on it, reads as no queue (see queue_free_rtt).
+  const microseconds measured = queue_free_rtt(ping, rtt);
+  if (!free_base_ || measured < *free_base_) free_base_ = measured;
 
   // Pings written before the last change measured the old window: they do not count towards the next.
   if (ping.sent < period_start_) return true;
-  period_min_rtt_ = period_pongs_ == 0 ? rtt : std::min(period_min_rtt_, rtt);
+  period_min_rtt_ = period_pongs_ == 0 ? measured : std::min(period_min_rtt_, measured);
   period_limited_ = period_limited_ || ping.window_limited;
   if (++period_pongs_ >= kPongsPerPeriod) adjust_window(now);
   return true;
@@ -90,6 +100,7 @@ void CongestionControl::restart_after_idle(TimePoint now) {
   // The lowest RTT is learnt again too: a path that got longer while idle would otherwise read as a
   // standing queue and shrink the window for good.
   base_rtt_.reset();
+  free_base_.reset();
   rate_anchor_.reset();
   start_period(now);
 }
@@ -101,7 +112,7 @@ void CongestionControl::start_period(TimePoint now) {
 }
 
 void CongestionControl::adjust_window(TimePoint now) {
-  const microseconds base = *base_rtt_;
+  const microseconds base = free_base_.value_or(*base_rtt_);
   const microseconds measured = period_min_rtt_;  // the least-queued ping of the period
   const microseconds queue = measured - base;
 
@@ -149,6 +160,37 @@ void CongestionControl::sample_rate(TimePoint now, const Ping& ping, microsecond
                         std::chrono::duration<double>(span).count();
   delivery_rate_ = delivery_rate_ == 0 ? sample : delivery_rate_ + kRateGain * (sample - delivery_rate_);
   rate_anchor_ = RateAnchor{now, ping.position};
+}
+
+// An update's answer comes at the earliest a base RTT after it was written, and not before the previous
+// answer (its bytes queue behind the earlier ones). The time past that is how long its own bytes took to
+// cross the slowest hop (or the client to take them in): bytes / that time is a sample of the path's rate,
+// queue or no queue.
+void CongestionControl::sample_path_rate(TimePoint now, const Ping& ping) {
+  const std::optional<TimePoint> previous = last_pong_at_;
+  last_pong_at_ = now;
+  if (!base_rtt_ || ping.burst < kMinPathBurst) return;
+  TimePoint earliest = ping.sent + free_base_.value_or(*base_rtt_);
+  if (previous && *previous > earliest) earliest = *previous;
+  const auto spread = now - earliest;
+  if (spread < kMinPathSpread) return;
+  path_samples_.push_back(static_cast<double>(ping.burst) / std::chrono::duration<double>(spread).count());
+  if (path_samples_.size() > kPathSamples) path_samples_.pop_front();
+  std::vector<double> sorted(path_samples_.begin(), path_samples_.end());
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  path_rate_ = sorted[sorted.size() / 2];
+}
+
+// The RTT without the time the update's own bytes needed to cross the path: a big update on a slow link
+// takes long to arrive even with nothing ahead of it, and that is not a queue. What remains above the base
+// (measured the same way) is waiting behind earlier bytes, which is what the window must keep short.
+// Without this, a base RTT learnt from a small fence makes every large update look queued, and the window
+// falls to one update per round trip. Without a path rate yet, the RTT as measured.
+microseconds CongestionControl::queue_free_rtt(const Ping& ping, microseconds rtt) const {
+  if (!options_.discount_own_bytes || path_rate_ <= 0) return rtt;
+  const auto own = std::chrono::duration_cast<microseconds>(
+      std::chrono::duration<double>(static_cast<double>(ping.burst) / path_rate_));
+  return std::max(microseconds{1}, rtt - own);
 }
 
 }  // namespace rfbsim::detail

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <deque>
 #include <optional>
+#include <vector>
 
 namespace rfbsim::detail {
 
@@ -31,6 +32,18 @@ class CongestionControl {
   static constexpr std::uint32_t kMinWindow = 4 * 1024;
   /// The window never grows above this (bytes).
   static constexpr std::uint32_t kMaxWindow = 4 * 1024 * 1024;
+
+  /// Choices that change the window's arithmetic.
+  struct Options {
+    /// Leave each update's own time on the path out of its RTT (and out of the base), using path_rate().
+    /// On: a big update alone on a slow link reads as no queue, so the window can hold the link's
+    /// rate x RTT plus an update and keep the link busy. Off: TigerVNC's plain scheme, where a base RTT
+    /// learnt from a small fence makes every large update look queued (one update per round trip).
+    bool discount_own_bytes = true;
+  };
+
+  CongestionControl() = default;
+  explicit CongestionControl(const Options& options) : options_(options) {}
 
   /// The stream position (total bytes written to this client so far) at `now`; call after every write.
   void update_position(TimePoint now, std::uint64_t position);
@@ -57,11 +70,18 @@ class CongestionControl {
   [[nodiscard]] double delivery_rate() const { return delivery_rate_; }
   /// Whether the window is still doubling each measurement period.
   [[nodiscard]] bool in_slow_start() const { return slow_start_; }
+  /// The path's rate in bytes per second (0 = unknown), from how long each update took to arrive: the
+  /// time from when its answer could first have come (a base RTT after it was written, or the previous
+  /// answer if that came later) to when it came. The median of recent samples, so that one slow answer
+  /// (a page busy decoding) does not drag it down. Unlike delivery_rate() it needs no queue: a stream that
+  /// does not fill the link still learns what the link could carry.
+  [[nodiscard]] double path_rate() const { return path_rate_; }
 
  private:
   struct Ping {
     TimePoint sent;
     std::uint64_t position;  // stream position just after the ping
+    std::uint64_t burst;     // bytes written since the ping before it (the update it follows)
     bool window_limited;     // the window was full once it was written: the sender had to wait
   };
   struct RateAnchor {
@@ -73,7 +93,10 @@ class CongestionControl {
   void start_period(TimePoint now);
   void adjust_window(TimePoint now);
   void sample_rate(TimePoint now, const Ping& ping, std::chrono::microseconds rtt);
+  void sample_path_rate(TimePoint now, const Ping& ping);
+  std::chrono::microseconds queue_free_rtt(const Ping& ping, std::chrono::microseconds rtt) const;
 
+  Options options_{};
   std::uint64_t position_ = 0;        // bytes written so far
   std::uint64_t acked_position_ = 0;  // position of the last answered ping
   std::deque<Ping> pings_;            // outstanding, oldest first
@@ -92,6 +115,14 @@ class CongestionControl {
   // Delivery rate: the last pong of an unbroken run of window-limited, queued pings, and the estimate.
   std::optional<RateAnchor> rate_anchor_;
   double delivery_rate_ = 0;
+
+  // Path rate: the last answer's time, and recent per-update samples (bytes per second), newest last.
+  std::optional<TimePoint> last_pong_at_;
+  std::uint64_t last_ping_position_ = 0;
+  std::deque<double> path_samples_;
+  double path_rate_ = 0;
+  // The lowest RTT seen less the update's own time on the path: the base the queue is measured from.
+  std::optional<std::chrono::microseconds> free_base_;
 };
 
 }  // namespace rfbsim::detail

@@ -18,8 +18,12 @@ constexpr std::uint64_t kFull = 5 * 1024 * 1024;  // an update larger than any w
 const TimePoint t0 = TimePoint{} + 1h;
 
 // A server's side of one connection on a fake clock: updates, each followed by its ping.
+// The window's arithmetic as published (TigerVNC's scheme): the delays these tests state are queueing,
+// so the update's own time on the path is not discounted here (the simulated links below discount it).
+const CongestionControl::Options kPlainScheme{false};
+
 struct Sender {
-  CongestionControl cc;
+  CongestionControl cc{kPlainScheme};
   std::uint64_t position = 0;
   TimePoint t = t0;  // where the next period starts
 
@@ -267,6 +271,7 @@ struct Outcome {
   double worst_backlog = 0;              // bytes at the bottleneck, after convergence
   double delivered_rate = 0;             // bytes/s arriving at the client after convergence
   double estimated_rate = 0;             // CongestionControl::delivery_rate() at the end
+  double path_rate = 0;                  // CongestionControl::path_rate() at the end
 };
 
 constexpr std::uint64_t kFrameBytes = 40000;
@@ -276,8 +281,9 @@ constexpr auto kLength = 60s;
 // A sender offering a 40 KB frame every 33 ms, pinging after each one sent. A frame that finds the
 // window full is held and coalesces with later ones; a held frame goes out at the next frame tick or
 // pong that finds room, as the server does. `controlled` = false sends every frame regardless.
-Outcome simulate(std::chrono::milliseconds rtt, double rate, bool controlled = true) {
-  CongestionControl cc;
+Outcome simulate(std::chrono::milliseconds rtt, double rate, bool controlled = true,
+                 CongestionControl::Options options = {}, bool announce = false) {
+  CongestionControl cc(options);
   Path path{rtt / 2, rate};
   std::deque<TimePoint> pongs;  // due times; the path is FIFO, so they come back in order
   std::uint64_t position = 0, delivered = 0;
@@ -303,6 +309,12 @@ Outcome simulate(std::chrono::milliseconds rtt, double rate, bool controlled = t
   };
 
   TimePoint next_frame = t0;
+  if (announce) {
+    // The server's first fence, before any frame: its round trip is the bare path's.
+    pongs.push_back(write(t0, kPingBytes) + path.one_way);
+    cc.sent_ping(t0, position);
+    next_frame += rtt;
+  }
   while (next_frame < end) {
     if (!pongs.empty() && pongs.front() <= next_frame) {
       const TimePoint now = pongs.front();
@@ -321,6 +333,7 @@ Outcome simulate(std::chrono::milliseconds rtt, double rate, bool controlled = t
   const std::chrono::duration<double> measured = kLength - kConverged;
   out.delivered_rate = static_cast<double>(delivered) / measured.count();
   out.estimated_rate = cc.delivery_rate();
+  out.path_rate = cc.path_rate();
   return out;
 }
 
@@ -340,19 +353,47 @@ TEST_CASE("simulated 50 ms / 5 Mbit/s link: short queue, rate near the cap", "[c
                << out.worst_rtt.count() << " us, backlog " << out.worst_backlog << " B, delivered "
                << out.delivered_rate << " B/s, estimate " << out.estimated_rate << " B/s");
   CHECK(out.unasked_pongs == 0);
-  CHECK(out.worst_rtt < out.base_rtt + 100ms);
+  // Discounting each frame's own 64 ms on the link lets one more frame wait at the bottleneck than the
+  // plain scheme does (below): up to one frame's time more on top of the plain bound.
+  CHECK(out.worst_rtt < out.base_rtt + 100ms + 64ms);
   CHECK(out.worst_backlog < Path::kBufferBytes / 8);
   CHECK(out.delivered_rate >= 0.8 * kCap);
   // The estimate measures the bottleneck, not our offered 1.2 MB/s.
   CHECK(out.estimated_rate >= 0.8 * kCap);
   CHECK(out.estimated_rate <= 1.01 * kCap);
+  // The path rate, learnt from each frame's time on the link, is the cap too.
+  CHECK(out.path_rate >= 0.9 * kCap);
+  CHECK(out.path_rate <= 1.1 * kCap);
   // Golden: the run is deterministic; a deliberate change to the window rules updates this and says why.
   CHECK(out.sent == 934);
+
+  // The plain scheme: here every ping follows a frame, so its base RTT already holds one frame's time and
+  // it too keeps the link full, with a queue of one or two frames at most.
+  const Outcome plain = simulate(50ms, kCap, true, kPlainScheme);
+  CHECK(plain.worst_rtt < plain.base_rtt + 100ms);
+  CHECK(plain.delivered_rate >= 0.8 * kCap);
 
   // The control: the same sender ignoring the window fills the bottleneck's buffer for the whole minute.
   const Outcome uncontrolled = simulate(50ms, kCap, false);
   CHECK(uncontrolled.worst_rtt > 10s);
   CHECK(uncontrolled.worst_backlog > Path::kBufferBytes);
+}
+
+// The server announces Fence with a fence of its own before the first frame, so the lowest RTT it sees is
+// the bare path's (50 ms), without any frame's time on the link. The plain scheme then reads each 40 KB
+// frame's own 64 ms at 5 Mbit/s as a queue over its 50 ms limit and shrinks to one frame per round trip
+// (~8.7 frames/s of the ~15.6 the link carries); discounting a frame's own time keeps the link full.
+TEST_CASE("simulated 50 ms / 5 Mbit/s link after a bare fence: a frame's own time is not a queue",
+          "[congestion_control]") {
+  constexpr double kCap = 5e6 / 8;
+  const Outcome out = simulate(50ms, kCap, true, {}, true);
+  const Outcome plain = simulate(50ms, kCap, true, kPlainScheme, true);
+  INFO("discounted: sent " << out.sent << ", " << out.delivered_rate << " B/s, worst " << out.worst_rtt.count()
+                           << " us; plain: sent " << plain.sent << ", " << plain.delivered_rate << " B/s");
+  CHECK(out.base_rtt < 51ms);  // the bare fence: 9 bytes cross 5 Mbit/s in 14 us
+  CHECK(out.delivered_rate >= 0.8 * kCap);
+  CHECK(out.worst_rtt < 50ms + 100ms + 2 * 64ms);
+  CHECK(plain.delivered_rate < 0.7 * kCap);
 }
 
 // Why 90%: with no queue ever, slow start doubles each period (~RTT + 3 pings, ~0.27 s) from 16 KiB to
