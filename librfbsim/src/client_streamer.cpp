@@ -25,6 +25,10 @@ constexpr std::uint8_t kPingPayload[] = {'p'};
 constexpr std::uint64_t kPingBytes = 9 + sizeof kPingPayload;
 // H.264's rate cap from the link's measured rate: leave room for the fences, input echo and jitter.
 constexpr double kH264ShareOfLink = 0.8;
+// The lowest cap, in bits per pixel of each picture: 0.06 is 1.7 Mbit/s at 1280x720 and 30 frames a second,
+// about where the warehouse walk at 720p still looks sharp enough to read the HUD; below it fewer pictures
+// (the congestion window) are the better trade than blurrier ones.
+constexpr double kH264MinCapBitsPerPixel = 0.06;
 // How long after the last held picture the H.264 stream stays capped at the link's rate.
 constexpr auto kH264CapHold = std::chrono::seconds(5);
 
@@ -206,8 +210,11 @@ ClientStreamer::Sent ClientStreamer::send_h264(rfbClientPtr client, TimePoint no
   // our own pace, and each picture made smaller by it would lower the next cap: it would only ever fall.
   const double rate = congestion_.delivery_rate();
   const bool link_bound = last_hold_ && now - *last_hold_ < kH264CapHold;
-  encoder_->set_max_bitrate(link_bound && rate > 0 ? static_cast<int>(std::min(rate * 8.0 * kH264ShareOfLink, 2e9))
-                                                   : 0);
+  // A floor too: when the page, not the link, is what holds pictures back (a browser decoding slowly), the
+  // rate it takes in follows our own bitrate down, and smaller pictures would not help it.
+  const double cap = std::max(rate * 8.0 * kH264ShareOfLink, kH264MinCapBitsPerPixel * config_.width *
+                                                                  config_.height * config_.frame_rate);
+  encoder_->set_max_bitrate(link_bound && rate > 0 ? static_cast<int>(std::min(cap, 2e9)) : 0);
   const auto started = Clock::now();
   std::vector<std::uint8_t> picture;
   try {

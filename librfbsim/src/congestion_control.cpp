@@ -187,10 +187,12 @@ void CongestionControl::sample_path_rate(TimePoint now, const Ping& ping) {
 // Without this, a base RTT learnt from a small fence makes every large update look queued, and the window
 // falls to one update per round trip. Without a path rate yet, the RTT as measured.
 microseconds CongestionControl::queue_free_rtt(const Ping& ping, microseconds rtt) const {
-  if (!options_.discount_own_bytes || path_rate_ <= 0) return rtt;
+  if (!options_.discount_own_bytes || path_rate_ <= 0 || !base_rtt_) return rtt;
   const auto own = std::chrono::duration_cast<microseconds>(
       std::chrono::duration<double>(static_cast<double>(ping.burst) / path_rate_));
-  return std::max(microseconds{1}, rtt - own);
+  // Never below the lowest RTT actually seen: a rate underestimated (a page slow to take pictures in)
+  // would otherwise push the base below the path's and make every later answer look queued.
+  return std::max(*base_rtt_, rtt - own);
 }
 
 }  // namespace rfbsim::detail
