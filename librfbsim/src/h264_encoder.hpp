@@ -34,7 +34,7 @@ namespace rfbsim::detail {
 struct H264Tuning {
   /// x264 constant rate factor, 0..51 (lower = better and bigger); the measurements behind 23 are in
   /// h264_encoder.cpp.
-  double crf = 23.0;
+  double crf = 24.0;
   /// x264 speed preset. "superfast": ~1.5 ms a 720p picture more than "ultrafast" for 20-25% fewer bytes
   /// at equal SSIM, and much better pictures under a cap (see the .cpp).
   std::string preset = "superfast";
