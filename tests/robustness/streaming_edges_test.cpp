@@ -64,6 +64,15 @@ void expect_announcement(RawSocket& socket) {
   CHECK(bytes[10] == 150);
 }
 
+// A client that did the handshake, listed Raw, Fence and ContinuousUpdates, and read the server's
+// announcement.
+rfbsim::test::RfbServerInit negotiate_streaming(RawSocket& socket) {
+  const auto init = rfbsim::test::raw_rfb_handshake(socket);
+  REQUIRE(socket.send_all(rfbsim::test::rfb_set_encodings({kRaw, kFence, kContinuousUpdates})));
+  expect_announcement(socket);
+  return init;
+}
+
 // The socket is closed by the server within `timeout`.
 bool closed_by_server(RawSocket& socket, std::chrono::milliseconds timeout = 5s) {
   bool closed = false;
@@ -100,9 +109,7 @@ TEST_CASE("EnableContinuousUpdates for an area outside the framebuffer closes on
           "[robustness][streaming]") {
   ServedScene scene(small_server());
   RawSocket socket(scene.port());
-  const auto init = rfbsim::test::raw_rfb_handshake(socket);
-  REQUIRE(socket.send_all(rfbsim::test::rfb_set_encodings({kRaw, kFence, kContinuousUpdates})));
-  expect_announcement(socket);
+  const auto init = negotiate_streaming(socket);
   REQUIRE(socket.send_all(enable_continuous(true, 10, 0, init.width, init.height)));
   CHECK(closed_by_server(socket));
   socket.close();
@@ -112,9 +119,7 @@ TEST_CASE("EnableContinuousUpdates for an area outside the framebuffer closes on
 TEST_CASE("a fence payload over 64 bytes closes only that client", "[robustness][streaming]") {
   ServedScene scene(small_server());
   RawSocket socket(scene.port());
-  rfbsim::test::raw_rfb_handshake(socket);
-  REQUIRE(socket.send_all(rfbsim::test::rfb_set_encodings({kRaw, kFence, kContinuousUpdates})));
-  expect_announcement(socket);
+  negotiate_streaming(socket);
   REQUIRE(socket.send_all(fence(1U << 31, std::vector<std::uint8_t>(65, 'x'))));
   CHECK(closed_by_server(socket));
   socket.close();
@@ -135,9 +140,7 @@ TEST_CASE("a fence from a client that did not list Fence closes only that client
 TEST_CASE("truncated 150 and 248 messages are dropped after the read timeout", "[robustness][streaming]") {
   ServedScene scene(small_server());
   RawSocket socket(scene.port());
-  rfbsim::test::raw_rfb_handshake(socket);
-  REQUIRE(socket.send_all(rfbsim::test::rfb_set_encodings({kRaw, kFence, kContinuousUpdates})));
-  expect_announcement(socket);
+  negotiate_streaming(socket);
   SECTION("EnableContinuousUpdates cut after 3 bytes") {
     REQUIRE(socket.send_all(std::vector<std::uint8_t>{150, 1, 0}));
   }
@@ -155,9 +158,7 @@ TEST_CASE("a client's fence request is answered with Request, SyncNext and unkno
           "[robustness][streaming]") {
   ServedScene scene(small_server());
   RawSocket socket(scene.port());
-  const auto init = rfbsim::test::raw_rfb_handshake(socket);
-  REQUIRE(socket.send_all(rfbsim::test::rfb_set_encodings({kRaw, kFence, kContinuousUpdates})));
-  expect_announcement(socket);
+  const auto init = negotiate_streaming(socket);
   constexpr std::uint32_t kAsked = (1U << 31) | (1U << 2) | (1U << 0) | (1U << 20);  // Request SyncNext BlockBefore ?
   REQUIRE(socket.send_all(fence(kAsked, {'a', 'b', 'c'})));
   std::vector<std::uint8_t> answer;
@@ -171,9 +172,7 @@ TEST_CASE("a client's fence request is answered with Request, SyncNext and unkno
 TEST_CASE("unasked fence answers are ignored and the client stays served", "[robustness][streaming]") {
   ServedScene scene(small_server());
   RawSocket socket(scene.port());
-  const auto init = rfbsim::test::raw_rfb_handshake(socket);
-  REQUIRE(socket.send_all(rfbsim::test::rfb_set_encodings({kRaw, kFence, kContinuousUpdates})));
-  expect_announcement(socket);
+  const auto init = negotiate_streaming(socket);
   // The first answers the server's announcement fence; the rest match nothing.
   for (int i = 0; i < 5; ++i) REQUIRE(socket.send_all(fence(0, {'p'})));
   CHECK(still_answers_requests(socket, init));
