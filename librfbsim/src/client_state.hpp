@@ -16,6 +16,7 @@ struct ClientState {
   explicit ClientState(const StreamerConfig& config) : streamer(config) {}
 
   ClientInfo info;
+  std::chrono::steady_clock::time_point connected{};  // when libvncserver took the client (handshake deadline)
   int guard_fd = -1;  // our dup of the client's socket, for the watchdog (libvncserver may close its own)
   std::optional<std::chrono::steady_clock::time_point> backed_up_since;  // output above the unsent limit since
   std::chrono::steady_clock::time_point update_started{};

@@ -10,6 +10,7 @@
 #include <poll.h>
 #include <rfb/rfb.h>
 #include <linux/sockios.h>
+#include <sys/epoll.h>
 #include <sys/eventfd.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
@@ -17,6 +18,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -29,6 +31,7 @@
 #include <utility>
 
 #include "client_state.hpp"
+#include "origin_policy.hpp"
 #include "rfb_extension.hpp"
 #include "server_impl.hpp"
 
@@ -93,6 +96,10 @@ ServerOptions validated(ServerOptions o) {
   if (!o.web_root.empty() && !std::filesystem::is_regular_file(std::filesystem::path(o.web_root) / "index.html")) {
     throw std::runtime_error("web root '" + o.web_root + "' has no index.html");
   }
+  for (const auto& origin : o.allowed_origins) {
+    if (const std::string error = detail::allowed_origin_error(origin); !error.empty()) throw std::runtime_error(error);
+  }
+  if (o.max_pending_connections < 1) throw std::runtime_error("max_pending_connections must be at least 1");
   for (const auto& route : o.json_routes) {
     if (route.first.empty() || route.first.front() != '/') {
       throw std::runtime_error("json route '" + route.first + "' must start with '/'");
@@ -121,11 +128,16 @@ Server::Impl::Impl(ServerOptions o)
   streamer_config.adaptive_quality = options.adaptive_quality && options.jpeg_quality > 0;
   streamer_config.codec = options.codec;
 
-  listener = detail::open_listener(options.bind_address, options.port);
+  listener = options.unix_socket_path.empty() ? detail::open_listener(options.bind_address, options.port)
+                                              : detail::open_unix_listener(options.unix_socket_path);
   wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  if (wake_fd < 0) {
-    ::close(listener.fd);
-    throw std::runtime_error("cannot create an eventfd");
+  pending_epoll = ::epoll_create1(EPOLL_CLOEXEC);
+  if (wake_fd < 0 || pending_epoll < 0) {
+    const std::string cause = std::strerror(errno);
+    detail::close_listener(listener);
+    if (wake_fd >= 0) ::close(wake_fd);
+    if (pending_epoll >= 0) ::close(pending_epoll);
+    throw std::runtime_error("cannot create an eventfd or epoll set: " + cause);
   }
 
   // The framebuffer starts a neutral dark grey until the first frame arrives.
@@ -140,8 +152,9 @@ Server::Impl::Impl(ServerOptions o)
   char* argv[] = {program, nullptr};
   screen = rfbGetScreen(&argc, argv, options.width, options.height, 8, 3, 4);
   if (screen == nullptr) {
-    ::close(listener.fd);
+    detail::close_listener(listener);
     ::close(wake_fd);
+    ::close(pending_epoll);
     throw std::runtime_error("libvncserver could not create a screen");
   }
   // Our frames are RGBA bytes: red in the lowest byte of each little-endian 32-bit pixel.
@@ -194,27 +207,46 @@ Server::Impl::~Impl() {
   rfbScreenCleanup(screen);
   for (const auto& connection : pending) ::close(connection.fd);
   http.reset();
-  ::close(listener.fd);
+  detail::close_listener(listener);
   ::close(wake_fd);
+  ::close(pending_epoll);
 }
 
+bool Server::Impl::checks_origins() const {
+  if (options.proxy_protocol) return false;
+  const auto& allowed = options.allowed_origins;
+  return std::find(allowed.begin(), allowed.end(), "*") == allowed.end();
+}
+
+// Until the next thing that happens by the clock alone: a pending connection's sniff or PROXY timeout, the
+// end of a pause in accepting, a look at backed-up clients; at most kIdlePollMs.
 int Server::Impl::poll_timeout_ms() const {
-  const int idle = any_backed_up ? kBackedUpPollMs : kIdlePollMs;
-  if (pending.empty()) return idle;
-  auto earliest = pending.front().accepted;
-  for (const auto& connection : pending) earliest = std::min(earliest, connection.accepted);
-  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(earliest + kSniffTimeout - Clock::now());
-  return static_cast<int>(std::clamp<std::int64_t>(left.count() + 1, 1, idle));
+  const auto now = Clock::now();
+  auto next = now + std::chrono::milliseconds(any_backed_up ? kBackedUpPollMs : kIdlePollMs);
+  for (const auto& connection : pending) {
+    const Clock::duration wait = connection.proxied ? sniff_timeout() : Clock::duration(options.read_timeout);
+    next = std::min(next, connection.accepted + wait);
+  }
+  if (accept_paused_until > now) next = std::min(next, accept_paused_until);
+  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(next - now);
+  return static_cast<int>(std::max<std::int64_t>(left.count() + 1, 1));
+}
+
+void Server::Impl::drain_pending_events() {
+  epoll_event events[64];
+  while (::epoll_wait(pending_epoll, events, 64, 0) == 64) {
+  }
 }
 
 void Server::Impl::run() {
   std::vector<pollfd> fds;
   while (!stopping) {
-    // Wait for a new connection, a new frame, a pending connection's first bytes or a client message.
+    // Wait for a new connection, a new frame, new bytes from a pending connection or a client message.
+    // The listener sits out a pause in accepting: it stays readable while descriptors are short.
     fds.clear();
-    fds.push_back({listener.fd, POLLIN, 0});
+    if (Clock::now() >= accept_paused_until) fds.push_back({listener.fd, POLLIN, 0});
     fds.push_back({wake_fd, POLLIN, 0});
-    for (const auto& connection : pending) fds.push_back({connection.fd, POLLIN, 0});
+    fds.push_back({pending_epoll, POLLIN, 0});
     rfbClientIteratorPtr it = rfbGetClientIterator(screen);
     for (rfbClientPtr cl = rfbClientIteratorNext(it); cl != nullptr; cl = rfbClientIteratorNext(it)) {
       if (cl->sock != RFB_INVALID_SOCKET) fds.push_back({cl->sock, POLLIN, 0});
@@ -225,7 +257,8 @@ void Server::Impl::run() {
 
     std::uint64_t wakes = 0;
     [[maybe_unused]] auto n = ::read(wake_fd, &wakes, sizeof wakes);
-    accept_new();
+    drain_pending_events();
+    accept_new(Clock::now());
     classify_pending();
     apply_newest_frame();
     serve_clients(fds);
@@ -276,11 +309,24 @@ void Server::Impl::serve_clients(const std::vector<pollfd>& polled) {
   }
   publish_streams(now);
 
+  drop_stalled_handshakes(now);
+
   // 3. Forget the clients that left or were dropped above (this runs on_client_gone).
   for (rfbClientPtr cl = screen->clientHead; cl != nullptr;) {
     rfbClientPtr next = cl->next;
     if (cl->sock == RFB_INVALID_SOCKET) rfbClientConnectionGone(cl);
     cl = next;
+  }
+}
+
+void Server::Impl::drop_stalled_handshakes(Clock::time_point now) {
+  for (rfbClientPtr cl = screen->clientHead; cl != nullptr; cl = cl->next) {
+    const auto* state = static_cast<const ClientState*>(cl->clientData);
+    if (cl->sock == RFB_INVALID_SOCKET || state == nullptr || cl->state == rfbClientRec::RFB_NORMAL) continue;
+    if (now - state->connected < kHandshakeTimeout) continue;
+    std::fprintf(stderr, "[rfbsim.server] dropping client %d: no RFB handshake within %lld s\n", state->info.id,
+                 static_cast<long long>(std::chrono::duration_cast<std::chrono::seconds>(kHandshakeTimeout).count()));
+    rfbCloseClient(cl);
   }
 }
 
@@ -350,6 +396,7 @@ Server::~Server() = default;
 int Server::port() const { return impl_->listener.port; }
 
 std::string Server::url() const {
+  if (!impl_->listener.unix_path.empty()) return "unix:" + impl_->listener.unix_path;
   const std::string& address = impl_->options.bind_address;
   const bool ipv6 = address.find(':') != std::string::npos;
   const std::string host = ipv6 ? "[" + address + "]" : address;

@@ -25,6 +25,7 @@ std::string peer_address(int fd) {
   sockaddr_storage peer{};
   socklen_t length = sizeof peer;
   if (::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &length) != 0) return "?";
+  if (peer.ss_family == AF_UNIX) return "local";  // a unix socket's peer has no address of its own
   char text[INET6_ADDRSTRLEN] = {};
   if (peer.ss_family == AF_INET6) {
     ::inet_ntop(AF_INET6, &reinterpret_cast<sockaddr_in6*>(&peer)->sin6_addr, text, sizeof text);
@@ -40,6 +41,13 @@ rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
   Impl& self = of(cl);
   // Set before refusing too: refused clients also pass through the hook (see on_client_gone).
   cl->clientGoneHook = on_client_gone;
+  // A WebSocket whose request head came after the intake stopped waiting for it (it then took the client
+  // for raw RFB): its Origin was never checked, so a browser-facing port turns it away. A real browser's
+  // head comes with the connection's first packet; noVNC simply reconnects.
+  if (cl->wsctx != nullptr && !self.adopting_head_checked && self.checks_origins()) {
+    std::fprintf(stderr, "[rfbsim.server] refusing a WebSocket whose request came too late to check its Origin\n");
+    return RFB_CLIENT_REFUSE;
+  }
   if (self.clients.load() >= self.options.max_clients) {
     std::fprintf(stderr, "[rfbsim.server] refusing a client: %d of %d already connected\n", self.clients.load(),
                  self.options.max_clients);
@@ -50,6 +58,8 @@ rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
   state->info.address = self.adopting_address.empty() ? peer_address(cl->sock) : self.adopting_address;
   state->info.websocket = cl->wsctx != nullptr;
   state->guard_fd = std::exchange(self.adopting_guard_fd, -1);
+  state->connected = Clock::now();
+  self.full_refusals = 0;
   cl->clientData = state;
   cl->clientFramebufferUpdateRequestHook = on_update_request;
   cl->viewOnly = self.options.view_only ? TRUE : FALSE;

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -35,8 +36,14 @@ using Clock = std::chrono::steady_clock;
 
 // How long a silent new connection may take to show whether it speaks HTTP. Raw RFB clients wait for the
 // server to speak first, so they are only recognised by this timeout; browsers send their request at once.
-// A server with nothing to serve over HTTP skips this wait (see Impl::serves_http).
+// A server with nothing to serve over HTTP waits less (kRfbOnlySniffTimeout, see Impl::serves_http).
 constexpr auto kSniffTimeout = std::chrono::milliseconds(500);
+// The same wait on a port that serves no HTTP: there only a WebSocket upgrade's head is worth waiting for,
+// and a browser sends it with the connection's first packet, so a short wait tells it from a raw RFB client.
+constexpr auto kRfbOnlySniffTimeout = std::chrono::milliseconds(100);
+// How long a client may take to finish the RFB handshake (version, security, init: a few round trips and
+// no human step). Until then it holds one of max_clients, so an idle connection must not keep it.
+constexpr auto kHandshakeTimeout = std::chrono::seconds(10);
 
 // A connection accepted but not yet known to be HTTP, WebSocket or raw RFB.
 struct PendingConnection {
@@ -51,13 +58,35 @@ struct Server::Impl {
   ~Impl();
 
   void run();
-  void accept_new();
+  // Accepts a batch of new connections into `pending`, unless accepting is paused.
+  void accept_new(Clock::time_point now);
+  // Out of descriptors or memory: no accepting for a while (the listener stays readable), logged once.
+  void pause_accepting(Clock::time_point now, int error);
+  // Puts a new connection on the intake list and in its epoll set, closing the oldest one if full.
+  void add_pending(int fd, Clock::time_point now);
+  // Takes a connection off the intake list and out of the epoll set (the socket stays open).
+  std::vector<PendingConnection>::iterator release_pending(std::vector<PendingConnection>::iterator it);
   void classify_pending();
+  // Whether a WebSocket upgrade whose head is `head` may go on (its Origin passed); false after answering
+  // it 403 and closing the socket.
+  bool admit_websocket(int fd, std::string_view head);
+  void log_refused_origin(const std::string& origin);
   // Hands a connection to libvncserver; `address` (from a PROXY line) replaces the socket's peer if given.
-  void adopt_rfb(int fd, const std::string& address = "");
+  // `head_checked`: a WebSocket head, if any, has been seen and its Origin admitted (or needs none).
+  void adopt_rfb(int fd, const std::string& address, bool head_checked);
+  // How long a connection's first bytes may take before it is judged by what came (see kSniffTimeout).
+  [[nodiscard]] Clock::duration sniff_timeout() const {
+    return serves_http ? Clock::duration(kSniffTimeout) : Clock::duration(kRfbOnlySniffTimeout);
+  }
+  // Whether WebSocket upgrades must pass the Origin check here (a browser-facing port that allows not all).
+  [[nodiscard]] bool checks_origins() const;
   // Reads a pending connection's PROXY line once it is whole. False: close the connection (no valid line).
   bool take_proxy_header(PendingConnection& connection, std::string_view bytes, Clock::time_point now);
+  // Reads the pending connections' readiness from their epoll set, so that it reports only new events.
+  void drain_pending_events();
   void apply_newest_frame();
+  // Drops clients still in the RFB handshake kHandshakeTimeout after they came: each holds a client slot.
+  void drop_stalled_handshakes(Clock::time_point now);
   void serve_clients(const std::vector<pollfd>& polled);
   bool may_send_update(rfbClientPtr cl, Clock::time_point now);
   int poll_timeout_ms() const;
@@ -86,11 +115,19 @@ struct Server::Impl {
   TileDamage damage;
   InputQueue input;
   detail::HeldKeys held_keys;             // network thread only
-  std::vector<PendingConnection> pending; // network thread only
+  std::vector<PendingConnection> pending; // network thread only; oldest first, at most max_pending_connections
+  int pending_epoll = -1;                 // edge-triggered readiness of the pending connections
+  Clock::time_point accept_paused_until{};  // no accept4 before this (out of descriptors)
+  std::uint64_t accept_refusals = 0;      // accept4 failures for lack of resources since the last success
+  std::uint64_t pending_evicted = 0;      // pending connections closed to make room
+  std::uint64_t origins_refused = 0;      // WebSocket upgrades refused for their Origin
+  std::set<std::string> logged_origins;   // refused origins already named in the log (bounded)
+  std::uint64_t full_refusals = 0;        // clients refused for max_clients since one was last accepted
   std::unique_ptr<detail::HttpService> http;
   detail::CallWatchdog watchdog;          // cuts off a client that blocks the network thread
   int adopting_guard_fd = -1;             // handed from adopt_rfb to on_new_client
   std::string adopting_address;           // handed from adopt_rfb to on_new_client; "" = the socket's peer
+  bool adopting_head_checked = false;     // handed from adopt_rfb to on_new_client
   bool any_backed_up = false;             // some client's output is above kMaxUnsentBytes
   detail::StreamerConfig streamer_config;  // what each client's ClientStreamer starts from
   Clock::time_point streams_published{};  // when `streams` was last refreshed

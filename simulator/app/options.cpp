@@ -2,6 +2,7 @@
 // sim_rfb's command-line parser.
 #include "app/options.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <climits>
 #include <functional>
@@ -31,6 +32,17 @@ bool is_identifier(const std::string& text) {
   return true;
 }
 
+// The shape of an --allow-origin value; librfbsim checks the host and port when the server starts.
+bool looks_like_origin(const std::string& text) {
+  if (text == "*") return true;
+  for (const std::string scheme : {"http://", "https://"}) {
+    if (text.rfind(scheme, 0) == 0) {
+      return text.size() > scheme.size() && text.find_first_of("/?#@ ", scheme.size()) == std::string::npos;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 std::string sim_usage() {
@@ -40,6 +52,7 @@ std::string sim_usage() {
          "               [--quality Q] [--codec auto|jpeg|h264] [--max-clients N] [--web-root DIR]\n"
          "               [--egl auto|device|surfaceless]\n"
          "               [--debug-overlay] [--rfb-only] [--proxy-protocol] [--ready-fd N]\n"
+         "               [--allow-origin ORIGIN]... [--unix-socket PATH]\n"
          "               [--data-dir DIR] [--uid ID] [--code-success C] [--code-timeout C]\n"
          "               [--time-limit S] [--trajectory-hz N]\n"
          "  --port N         TCP port for the page, WebSocket and RFB (default 5901; 0 = any free port)\n"
@@ -62,12 +75,19 @@ std::string sim_usage() {
          "  --debug-overlay  draw the robot's global path, local trajectory, goal, pose estimate and social\n"
          "                   cost on the floor (for developers; participants should not see it)\n"
          "  --rfb-only       serve RFB only (raw and over WebSocket): no page, no /status.json; a raw RFB\n"
-         "                   client is then served at once instead of after 0.5 s (for sim_manager's relay)\n"
+         "                   client is then served after 0.1 s instead of 0.5 s (at once behind --proxy-protocol)\n"
          "  --proxy-protocol each connection begins with a PROXY protocol v1 line naming the real client,\n"
          "                   as sim_manager's relay sends it (for a trusted relay only: never on a port\n"
          "                   that others reach)\n"
-         "  --ready-fd N     once listening, write 'ready PORT' and a newline to file descriptor N (3 or\n"
-         "                   above, e.g. a pipe from the parent) and keep it open: later lines report the\n"
+         "  --allow-origin O also accept WebSocket upgrades from pages at origin O (scheme://host[:port], or *\n"
+         "                   for any page); repeatable. Without it only this server's own page and loopback\n"
+         "                   pages (http(s)://127.0.0.1, localhost, [::1]) may open the stream; others get 403\n"
+         "  --unix-socket P  listen on unix socket P (mode 0600: only this user may connect) instead of TCP;\n"
+         "                   replaces --port and --bind (giving either is an error); a stale socket there is\n"
+         "                   replaced, the file is removed at exit\n"
+         "  --ready-fd N     once listening, write 'ready PORT' ('ready unix PATH' with --unix-socket) and a\n"
+         "                   newline to file descriptor N (3 or above, e.g. a pipe from the parent) and\n"
+         "                   keep it open: later lines report the\n"
          "                   viewers' stream about once a second ('stream codec=tight rtt_ms=12.5 fps=29.8\n"
          "                   quality=80 clients=1') and the task's outcome ('outcome completed' or 'outcome\n"
          "                   timeout'); exit 1 if the ready line cannot be written\n"
@@ -115,6 +135,15 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
        }},
       {"--max-clients", [&](const std::string& v) { return parse_number(v, 1, 64, o.max_clients); }},
       {"--web-root", [&](const std::string& v) { o.web_root = v; return !v.empty(); }},
+      {"--allow-origin", [&](const std::string& v) {
+         o.allowed_origins.push_back(v);
+         return looks_like_origin(v);
+       }},
+      {"--unix-socket", [&](const std::string& v) {
+         // The path goes into the one-line ready message: no line breaks or other control characters.
+         o.unix_socket = v;
+         return !v.empty() && std::none_of(v.begin(), v.end(), [](unsigned char c) { return c < 0x20 || c == 0x7f; });
+       }},
       {"--ready-fd", [&](const std::string& v) {
          // 0, 1 and 2 are stdin, stdout and stderr: writing the ready line there is surely a mistake.
          int fd = 0;
@@ -140,8 +169,10 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
          return v == "auto" || v == "device" || v == "surfaceless";
        }},
   };
+  bool port_or_bind_given = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
+    if (arg == "--port" || arg == "--bind") port_or_bind_given = true;
     if (arg == "--help" || arg == "-h") {
       o.help = true;
       continue;
@@ -172,11 +203,16 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
       outcome.error = "bad value '" + value + "' for " + arg;
       // A choice among names is spelt out, so that a typo is fixed without reading the help.
       if (arg == "--codec") outcome.error += " (expected auto, jpeg or h264)";
+      if (arg == "--allow-origin") outcome.error += " (expected scheme://host[:port] with http or https, or *)";
       return outcome;
     }
   }
   // Without HTTP there is no page to serve: a web root given anyway shows a misunderstanding.
   if (o.rfb_only && !o.web_root.empty()) outcome.error = "--rfb-only serves no page; drop --web-root";
+  // Silently ignoring them would leave the caller believing a TCP port is open.
+  if (!o.unix_socket.empty() && port_or_bind_given) {
+    outcome.error = "--unix-socket replaces --port and --bind; drop them";
+  }
   return outcome;
 }
 

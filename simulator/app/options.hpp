@@ -34,7 +34,13 @@ struct SimOptions {
   bool rfb_only = false;
   /// Each connection begins with a PROXY protocol line naming the real client (sim_manager's relay).
   bool proxy_protocol = false;
-  /// Once listening, write "ready <port>\n" to this file descriptor (3 or above), then about once a second
+  /// Pages allowed to open the stream besides the server's own and loopback ones (--allow-origin, repeatable):
+  /// "scheme://host[:port]" or "*" (rfbsim::ServerOptions::allowed_origins).
+  std::vector<std::string> allowed_origins;
+  /// Listen on this unix socket (mode 0600) instead of TCP; empty = TCP on bind:port.
+  std::string unix_socket;
+  /// Once listening, write "ready <port>\n" ("ready unix <path>\n" on a unix socket) to this file
+  /// descriptor (3 or above), then about once a second
   /// while someone watches a "stream ..." line (app/stream_status.hpp), and one line per outcome
   /// ("outcome completed\n"); closed when the program ends.
   std::optional<int> ready_fd;

@@ -94,9 +94,10 @@ struct ServerOptions {
   bool view_only = false;                    ///< ignore every key and pointer event
   std::string desktop_name = "rfbsim";       ///< the name RFB clients show
   /// Directory served to plain HTTP GETs; empty = none. With neither a web root nor json_routes the port
-  /// speaks RFB only: each new connection goes straight to libvncserver (raw RFB, or RFB over WebSocket,
-  /// which it detects itself), without the up to 500 ms wait that tells a silent raw RFB client from a
-  /// browser about to send an HTTP request; a plain HTTP request is then closed as a bad RFB client.
+  /// speaks RFB only (raw, or over WebSocket): a silent raw RFB client is served after at most 100 ms
+  /// instead of the up to 500 ms that tell it from a browser about to send its request (the request head
+  /// is still read first, to check its Origin), a plain HTTP request is closed unanswered, and behind proxy_protocol
+  /// a connection is handed to RFB as soon as its PROXY line is read.
   std::string web_root;
   /// A client that takes longer than this to send one whole message (input, update request, handshake
   /// step) is dropped: the one network thread waits for it meanwhile.
@@ -115,6 +116,19 @@ struct ServerOptions {
   /// connection without a valid line within read_timeout is closed. Never enable it on a port that
   /// untrusted peers reach directly: they could claim any address.
   bool proxy_protocol = false;
+  /// Pages whose WebSocket upgrades are accepted besides the server's own page (the request's Host, over
+  /// http or https) and loopback pages (http(s)://127.0.0.1, localhost or [::1], any port): exact
+  /// "scheme://host[:port]" entries (host case-insensitive), or "*" for any page. An upgrade with another
+  /// Origin gets 403; one without Origin (not a browser) is accepted. Not checked on proxy_protocol
+  /// connections: their relay checks origins itself.
+  std::vector<std::string> allowed_origins;
+  /// Accepted connections still being classified (PROXY line or first bytes not complete) at most; one
+  /// more closes the oldest of them, so a flood of idle connections cannot grow memory or starve new ones.
+  int max_pending_connections = 64;
+  /// Listen on this unix stream socket (created mode 0600: only this user may connect) instead of TCP;
+  /// `port` and `bind_address` are then ignored. A stale socket file there is replaced, any other file is
+  /// an error; the file is removed when the server stops. Empty = TCP.
+  std::string unix_socket_path;
 };
 
 /// Serves frames over RFB (raw TCP) and RFB-over-WebSocket on one port, plus optional static files and
@@ -122,16 +136,17 @@ struct ServerOptions {
 class Server {
  public:
   /// Binds, listens and starts the network thread. Throws std::runtime_error naming the cause
-  /// (bad size, address not valid, port in use, web root missing).
+  /// (bad size, address not valid, port in use, web root missing, bad allowed origin, socket path taken).
   explicit Server(ServerOptions options);
   /// Stops the network thread, closes every connection and releases held keys.
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  /// The port actually bound (useful with port 0).
+  /// The port actually bound (useful with port 0); 0 on a unix socket.
   [[nodiscard]] int port() const;
-  /// The URL that opens the web page (or the RFB endpoint when there is no web root).
+  /// The URL that opens the web page (or the RFB endpoint when there is no web root); "unix:PATH" on a
+  /// unix socket.
   [[nodiscard]] std::string url() const;
   /// Copies one frame (must be the server's size) into the latest-wins mailbox; never blocks on the
   /// network. Throws std::invalid_argument on a size mismatch.
