@@ -12,6 +12,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -81,10 +82,13 @@ std::string write_line(int fd, const std::string& line) {
   return "";
 }
 
-// Tells the parent that the port is open: one line "ready <port>\n" on `fd`. The pipe stays open for the
-// outcome line. Throws std::runtime_error when the write fails (EPIPE: the parent left).
-void report_ready(int fd, int port) {
-  const std::string error = write_line(fd, "ready " + std::to_string(port) + "\n");
+// Tells the parent that the port is open: one line "ready <port>\n" on `fd` ("ready unix <path>\n" when
+// listening on a unix socket). The pipe stays open for the outcome line. Throws std::runtime_error when the write fails (EPIPE: the parent left).
+void report_ready(int fd, const rfbsim::Server& server) {
+  const std::string& unix_socket = server.options().unix_socket_path;
+  const std::string line = unix_socket.empty() ? "ready " + std::to_string(server.port()) + "\n"
+                                               : "ready unix " + unix_socket + "\n";
+  const std::string error = write_line(fd, line);
   if (!error.empty()) {
     ::close(fd);
     throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": cannot write the ready line (" + error + ")");
@@ -215,6 +219,23 @@ void log_robot_events(const rfbsim::sim::World& world, double dt) {
   }
 }
 
+// Tests only: RFBSIM_TEST_FAIL_WRITES_AFTER=<bytes> makes the session data's writes fail with ENOSPC after that
+// many appended bytes, so that a full disk can be tested without one (record/sync_queue.hpp's WriteFaults).
+rfbsim::sim::SessionWriterOptions writer_options_from_environment() {
+  rfbsim::sim::SessionWriterOptions options;
+  const char* limit = std::getenv("RFBSIM_TEST_FAIL_WRITES_AFTER");
+  if (limit == nullptr) return options;
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long bytes = std::strtoull(limit, &end, 10);
+  if (*limit == '\0' || *end != '\0' || errno != 0) {
+    throw std::runtime_error(std::string("RFBSIM_TEST_FAIL_WRITES_AFTER: '") + limit + "' is not a byte count");
+  }
+  options.faults.fail_after_bytes = bytes;
+  std::fprintf(stderr, "[sim_rfb] test fault: session data writes fail after %llu bytes\n", bytes);
+  return options;
+}
+
 int run(const rfbsim::sim::SimOptions& options) {
   using Clock = std::chrono::steady_clock;
   namespace sim = rfbsim::sim;
@@ -240,9 +261,17 @@ int run(const rfbsim::sim::SimOptions& options) {
     if (!options.code_success.empty() || !options.code_timeout.empty()) {
       info.codes = std::make_pair(options.code_success, options.code_timeout);
     }
-    writer = std::make_unique<sim::SessionWriter>(options.data_dir, std::move(info), simulation.world());
+    writer = std::make_unique<sim::SessionWriter>(options.data_dir, std::move(info), simulation.world(),
+                                                  writer_options_from_environment());
   }
   sim::StudySession study(simulation, prepared.task, {options.code_success, options.code_timeout}, writer.get());
+  // A recording that stopped (a full disk) is told to the parent once, on the ready pipe; the session goes on.
+  const auto report_data_notice = [&] {
+    const std::string notice = study.take_data_notice();
+    if (notice.empty() || !options.ready_fd) return;
+    const std::string error = write_line(*options.ready_fd, notice);
+    if (!error.empty()) std::fprintf(stderr, "[sim_rfb] cannot report incomplete data to the parent: %s\n", error.c_str());
+  };
   const std::string address_key = sim::address_hash_key();
 
   StatusBoard status;
@@ -259,8 +288,11 @@ int run(const rfbsim::sim::SimOptions& options) {
   server_options.max_clients = options.max_clients;
   server_options.desktop_name = "rfbsim";
   server_options.proxy_protocol = options.proxy_protocol;
+  server_options.allowed_origins = options.allowed_origins;
+  server_options.unix_socket_path = options.unix_socket;
   // RFB only: no web root and no route, which librfbsim takes to mean no HTTP at all, so that a raw RFB
-  // client (sim_manager's relay) is served at once instead of after the wait that tells it from a browser.
+  // client is served sooner (at once after sim_manager's PROXY line) than after the wait for a browser's page
+  // request.
   if (!options.rfb_only) {
     server_options.web_root = find_web_root(options.web_root);
     server_options.json_routes["/status.json"] = [&status] { return status.read(); };
@@ -306,7 +338,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   // Readers of /status.json never see an empty document, even before the first tick.
   status.publish(sim::status_json(simulation.world(), 0, 0));
   // The parent's line first: if it cannot be told, we are not ready, and stdout should not say we are.
-  if (options.ready_fd) report_ready(*options.ready_fd, server.port());
+  if (options.ready_fd) report_ready(*options.ready_fd, server);
   std::printf("sim_rfb ready: %s\n", server.url().c_str());
   std::fflush(stdout);
 
@@ -357,6 +389,7 @@ int run(const rfbsim::sim::SimOptions& options) {
       break;
     }
     if (writer) writer->flush_if_due();
+    report_data_notice();
     const int clients = server.client_count();
     if (ticks > 0 && !options.rfb_only) {
       status.publish(
@@ -377,6 +410,7 @@ int run(const rfbsim::sim::SimOptions& options) {
     std::this_thread::sleep_until(wake);
   }
   study.finish(end_reason);
+  report_data_notice();  // the end's own writes may have been the ones that failed
   if (options.ready_fd) ::close(*options.ready_fd);
   std::fprintf(stderr, "[sim_rfb] stopping after %llu ticks, %llu frames (%s)\n",
                static_cast<unsigned long long>(simulation.world().tick),

@@ -9,6 +9,7 @@ StudySession::StudySession(Simulation& simulation, TaskSpec task, StudyCodes cod
   if (writer_ == nullptr) return;
   writer_->event(simulation_.world().tick, "session", {{"event", "start"}});
   writer_->sample(simulation_.world());
+  writer_->checkpoint();  // the start is on disk before anyone sees the world
 }
 
 void StudySession::key(std::uint32_t keysym, bool down, int client) {
@@ -74,6 +75,8 @@ void StudySession::record_task_events() {
         break;
     }
   }
+  // Each task event (the clock's start, a step, the outcome) goes to disk at once, with what led to it.
+  if (!monitor_.events().empty()) writer_->checkpoint();
   monitor_.clear_events();
 }
 
@@ -97,6 +100,14 @@ void StudySession::finish(const std::string& reason) {
   if (writer_ == nullptr) return;
   writer_->event(simulation_.world().tick, "session", {{"event", "end"}, {"reason", reason}});
   writer_->finish({simulation_.world().tick, reason});
+}
+
+std::string StudySession::take_data_notice() {
+  if (writer_ == nullptr || data_notice_given_) return "";
+  const std::optional<std::string> failure = writer_->failure();
+  if (!failure) return "";
+  data_notice_given_ = true;
+  return "data incomplete reason=" + *failure + "\n";
 }
 
 }  // namespace rfbsim::sim

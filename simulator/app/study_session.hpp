@@ -47,9 +47,14 @@ class StudySession {
   [[nodiscard]] const TaskMonitor& task() const { return monitor_; }
   [[nodiscard]] const Simulation& simulation() const { return simulation_; }
 
-  /// Records the end (a `session` event and session.json's end keys). `reason`: completed, timeout,
-  /// signal or error.
+  /// Records the end (a `session` event and session.json's end keys), and waits until it is on disk.
+  /// `reason`: completed, timeout, signal or error.
   void finish(const std::string& reason);
+
+  /// The line for the parent (sim_manager) once the session's data stopped being written:
+  /// "data incomplete reason=<one line of text>\n". Given once; "" before a failure, after it was given,
+  /// and without a writer.
+  [[nodiscard]] std::string take_data_notice();
 
  private:
   void record_task_events();
@@ -58,6 +63,7 @@ class StudySession {
   TaskMonitor monitor_;
   StudyCodes codes_;
   SessionWriter* writer_;
+  bool data_notice_given_ = false;
 };
 
 }  // namespace rfbsim::sim

@@ -222,6 +222,13 @@ SessionMeta parse_meta(const json& doc, const Where& where) {
     d.time = get_number(done, "time", where);
     meta.tasks_done.push_back(d);
   }
+  // Only in folders whose recording failed (and in none older than the key).
+  if (const auto it = doc.find("data_incomplete"); it != doc.end() && !it->is_null()) {
+    if (!it->is_object()) wrong("data_incomplete", "an object", where);
+    meta.data_incomplete = get_string(*it, "reason", where);
+    meta.dropped_bytes = static_cast<std::uint64_t>(
+        get_integer(*it, "dropped_bytes", 0, std::numeric_limits<std::int64_t>::max(), where));
+  }
   return meta;
 }
 

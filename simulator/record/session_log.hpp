@@ -84,6 +84,10 @@ struct SessionMeta {
   std::optional<std::string> outcome;     ///< completed or timeout; none without an outcome
   std::optional<SessionCompletion> completion;
   std::vector<TaskDone> tasks_done;
+  /// Why the recording stopped early (a full disk, a write error), when session.json says it did; the
+  /// files then end at the failure, not at the session's end.
+  std::optional<std::string> data_incomplete;
+  std::uint64_t dropped_bytes = 0;  ///< bytes of lines the writer dropped after the failure
 };
 
 /// One row of trajectories.csv: an agent's pose and velocity at a sample tick.

@@ -2,48 +2,22 @@
 // SessionWriter: session.json, trajectories.csv and events.jsonl.
 #include "record/session_writer.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <ctime>
 #include <stdexcept>
+#include <utility>
+
+#include "record/file_io.hpp"
 
 namespace rfbsim::sim {
 
 namespace {
 
-constexpr std::size_t kBufferLimit = 256 * 1024;  // bytes: written at once above this, whatever the clock
+constexpr std::size_t kBufferLimit = 256 * 1024;  // bytes: handed over at once above this, whatever the clock
 
-[[noreturn]] void fail(const std::filesystem::path& path, const char* what) {
-  throw std::runtime_error(path.string() + ": " + what + " (" + std::strerror(errno) + ")");
-}
-
-int open_append(const std::filesystem::path& path) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
-  if (fd < 0) fail(path, "cannot open for writing");
-  return fd;
-}
-
-// Appends `buffer` to `fd` and empties it. When a write fails partway (a full disk), what reached the file
-// leaves the buffer, so that a later flush continues the line instead of writing its start twice.
-void append_buffer(int fd, std::string& buffer, const std::filesystem::path& path) {
-  std::size_t done = 0;
-  while (done < buffer.size()) {
-    const ssize_t n = ::write(fd, buffer.data() + done, buffer.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int error = errno;
-      buffer.erase(0, done);
-      errno = error;
-      fail(path, "cannot write");
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  buffer.clear();
+[[noreturn]] void fail(const std::filesystem::path& dir, const std::string& what) {
+  throw std::runtime_error(dir.string() + ": " + what);
 }
 
 const char* party_name(Party party) {
@@ -92,7 +66,11 @@ std::string iso_utc_now() {
 
 SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const World& world,
                              std::chrono::milliseconds flush_interval)
-    : dir_(std::move(dir)), info_(std::move(info)), flush_interval_(flush_interval) {
+    : SessionWriter(std::move(dir), std::move(info), world, SessionWriterOptions{flush_interval, {}, {}}) {}
+
+SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const World& world,
+                             SessionWriterOptions options)
+    : dir_(std::move(dir)), info_(std::move(info)), flush_interval_(options.flush_interval) {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw std::runtime_error(dir_.string() + ": cannot create the session folder (" + ec.message() + ")");
@@ -142,20 +120,39 @@ SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const 
               {"outcome", nullptr},
               {"completion", nullptr},
               {"tasks_done", json::array()}};
-  write_session_json();
 
-  trajectory_fd_.fd = open_append(dir_ / "trajectories.csv");
-  events_fd_.fd = open_append(dir_ / "events.jsonl");
-  trajectory_buffer_ = "tick,time,kind,id,x,y,yaw,vx,vy\n";
+  // The folder's start is written here, synced, before the session begins: at the start a folder that
+  // cannot be written is an error, not a warning.
+  std::string error;
+  UniqueFd dir_fd = open_dir(dir_, error);
+  if (!dir_fd.valid()) fail(dir_, error);
+  const std::string document = session_.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+  if (const FileResult written = replace_file(dir_, dir_fd.get(), "session.json", document); !written.ok()) {
+    fail(dir_, written.error);
+  }
+  std::vector<std::pair<std::string, UniqueFd>> files;
+  for (const char* name : {"trajectories.csv", "events.jsonl"}) {
+    UniqueFd fd = open_append(dir_ / name, error);
+    if (!fd.valid()) throw std::runtime_error(error);
+    files.emplace_back(name, std::move(fd));
+  }
+  FileResult header = write_all(files[0].second.get(), "tick,time,kind,id,x,y,yaw,vx,vy\n", files[0].first);
+  if (header.ok()) header = sync_data(files[0].second.get(), files[0].first);
+  if (header.ok()) header = sync_dir(dir_fd.get(), dir_.string());
+  if (!header.ok()) fail(dir_, header.error);
+  // The folder's own name, in a folder that create_directories may just have made.
+  if (UniqueFd parent = open_dir(dir_.parent_path().empty() ? "." : dir_.parent_path(), error); parent.valid()) {
+    sync_dir(parent.get(), dir_.parent_path().string());
+  }
   last_flush_ = std::chrono::steady_clock::now();
-  write_buffers();  // at the start a folder that cannot be written is an error, not a warning
+  queue_ = std::make_unique<SyncQueue>(dir_, std::move(dir_fd), std::move(files), session_, options.limits,
+                                       std::move(options.faults));
 }
 
-SessionWriter::OwnedFd::~OwnedFd() {
-  if (fd >= 0) ::close(fd);
+SessionWriter::~SessionWriter() {
+  hand_over();
+  queue_->close();
 }
-
-SessionWriter::~SessionWriter() { flush(); }
 
 void SessionWriter::sample(const World& world) {
   if (world.tick % sample_every_ != 0) return;
@@ -188,82 +185,48 @@ void SessionWriter::world_events(const World& world) {
 
 void SessionWriter::task_done(const std::string& type, std::uint64_t tick) {
   session_["tasks_done"].push_back({{"type", type}, {"tick", tick}, {"time", time_of(tick)}});
-  update_session_json();
+  hand_over();
+  queue_->replace_document(session_);
 }
 
 void SessionWriter::outcome(const std::string& outcome, const std::string& code, std::uint64_t tick) {
   session_["outcome"] = outcome;
   session_["completion"] = {{"code", code}, {"tick", tick}, {"time", time_of(tick)}};
-  update_session_json();
-  flush();  // the outcome is what a study needs most: on disk now, not in half a second
+  // The outcome is what a study needs most: on disk now, with the lines that led to it.
+  hand_over();
+  queue_->replace_document(session_);
 }
 
 void SessionWriter::finish(const SessionEnd& end) {
   session_["ended_at"] = iso_utc_now();
   session_["end_tick"] = end.tick;
   session_["end_reason"] = end.reason;
-  flush();
-  update_session_json();
+  hand_over();
+  queue_->replace_document(session_);
+  queue_->close();
 }
 
 void SessionWriter::flush_if_due() {
   const auto now = std::chrono::steady_clock::now();
   if (now - last_flush_ >= flush_interval_ || trajectory_buffer_.size() + events_buffer_.size() > kBufferLimit) {
-    flush();
+    hand_over();
   }
 }
+
+void SessionWriter::checkpoint() { hand_over(); }
 
 bool SessionWriter::flush() {
-  try {
-    write_buffers();
-    return true;
-  } catch (const std::exception& e) {
-    report_trouble(e.what());
-    return false;
-  }
+  hand_over();
+  queue_->drain();
+  return !queue_->failure();
 }
 
-void SessionWriter::write_buffers() {
+void SessionWriter::hand_over() {
   last_flush_ = std::chrono::steady_clock::now();
-  // Whole lines per write: a kill between two writes leaves every line complete.
-  append_buffer(trajectory_fd_.fd, trajectory_buffer_, dir_ / "trajectories.csv");
-  append_buffer(events_fd_.fd, events_buffer_, dir_ / "events.jsonl");
-}
-
-void SessionWriter::update_session_json() {
-  try {
-    write_session_json();
-  } catch (const std::exception& e) {
-    report_trouble(e.what());
-  }
-}
-
-void SessionWriter::report_trouble(const std::string& what) {
-  // A full disk must not end the participant's session: say so (not every tick), keep the lines in
-  // memory and try again at the next flush.
-  const auto now = std::chrono::steady_clock::now();
-  if (last_trouble_report_ && now - *last_trouble_report_ < std::chrono::seconds(10)) return;
-  last_trouble_report_ = now;
-  std::fprintf(stderr, "[record] %s; kept in memory, retrying\n", what.c_str());
-}
-
-void SessionWriter::write_session_json() {
-  // Write a temporary file, sync it, rename it over: a reader (or a crash) sees the old or the new
-  // document, never half of one.
-  const std::filesystem::path target = dir_ / "session.json";
-  const std::filesystem::path temporary = dir_ / "session.json.tmp";
-  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) fail(temporary, "cannot open for writing");
-  try {
-    std::string text = session_.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
-    append_buffer(fd, text, temporary);
-  } catch (...) {
-    ::close(fd);
-    throw;
-  }
-  ::fdatasync(fd);
-  ::close(fd);
-  if (::rename(temporary.c_str(), target.c_str()) != 0) fail(target, "cannot replace");
+  // Whole lines per append: a kill between two writes leaves every line complete.
+  queue_->append(SyncQueue::kTrajectory, std::exchange(trajectory_buffer_, {}));
+  queue_->append(SyncQueue::kEvents, std::exchange(events_buffer_, {}));
+  queue_->sync();
 }
 
 }  // namespace rfbsim::sim

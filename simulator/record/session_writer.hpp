@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // SessionWriter: writes one session's data folder as it runs (docs/data.md): session.json, replaced
-// atomically whenever it changes; trajectories.csv and events.jsonl, appended and handed to the kernel at
-// least every flush interval, so that a killed process loses at most that much.
+// atomically whenever it changes; trajectories.csv and events.jsonl, appended in whole lines and synced to
+// the disk at least every flush interval and at every task event, so that a killed process (or a power cut)
+// loses at most that much. The disk work happens on a thread of its own (record/sync_queue.hpp): the
+// simulation thread only formats lines. A full disk or any write error stops the recording, never the
+// session: failure() then says why, and session.json carries the reason when the disk still takes it.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -14,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "record/sync_queue.hpp"
 #include "world/world.hpp"
 
 namespace rfbsim::sim {
@@ -41,12 +46,23 @@ struct SessionEnd {
   std::string reason;  ///< completed, timeout, signal, error
 };
 
+/// How a SessionWriter writes; the defaults are sim_rfb's.
+struct SessionWriterOptions {
+  /// Wall time between hand-overs (and syncs) while data flows; at most 2 s keeps a crash's loss under 2 s.
+  std::chrono::milliseconds flush_interval{500};
+  SyncQueueLimits limits;  ///< the writer thread's memory bound and the space reserved for a failure note
+  WriteFaults faults;      ///< tests only: a disk that fills or stalls on purpose
+};
+
 class SessionWriter {
  public:
-  /// Creates `dir` if needed and writes session.json (with `world`'s agents) and the CSV header. Throws
-  /// std::runtime_error naming the path when it cannot, or when `dir` already holds a session.
+  /// Creates `dir` if needed and writes session.json (with `world`'s agents) and the CSV header, synced.
+  /// Throws std::runtime_error naming the path when it cannot, or when `dir` already holds a session.
+  SessionWriter(std::filesystem::path dir, SessionInfo info, const World& world, SessionWriterOptions options = {});
+  /// As above with the default options but `flush_interval`.
   SessionWriter(std::filesystem::path dir, SessionInfo info, const World& world,
-                std::chrono::milliseconds flush_interval = std::chrono::milliseconds(500));
+                std::chrono::milliseconds flush_interval);
+  /// Writes out what is buffered and waits for the writer thread to finish.
   ~SessionWriter();
   SessionWriter(const SessionWriter&) = delete;
   SessionWriter& operator=(const SessionWriter&) = delete;
@@ -58,46 +74,43 @@ class SessionWriter {
   /// The contacts and robot state changes of the world's last tick, as events.
   void world_events(const World& world);
 
-  /// A finished task step, or the outcome: session.json is rewritten at once.
+  /// A finished task step: session.json is rewritten, after the lines so far, and synced.
   void task_done(const std::string& type, std::uint64_t tick);
+  /// The outcome: as task_done.
   void outcome(const std::string& outcome, const std::string& code, std::uint64_t tick);
-  /// The clean end: session.json gets its end keys, and everything is written out.
+  /// The clean end: session.json gets its end keys, everything is written out and synced, and the writer
+  /// thread stops (waiting for the disk). Later calls record nothing.
   void finish(const SessionEnd& end);
 
-  /// Hands buffered lines to the kernel when the flush interval has passed (or the buffer grew large).
+  /// Hands buffered lines to the writer thread, with a sync, when the flush interval has passed (or the
+  /// buffers grew large). Never waits for the disk.
   void flush_if_due();
-  /// Hands buffered lines to the kernel now. False when a write failed (a full disk): the lines not
-  /// written stay buffered for the next flush, and the trouble is logged (at most every 10 s). Never throws:
-  /// the participant's session goes on.
+  /// Hands buffered lines over with a sync now, without waiting: a task event, for instance.
+  void checkpoint();
+  /// Hands buffered lines over and waits until they are on disk. False when the recording has failed.
+  /// Never throws: the participant's session goes on.
   bool flush();
+
+  /// Why the recording stopped (a full disk, a write error, a disk that fell behind), on one line; none
+  /// while all is well. Lines after the failure are dropped, and counted in dropped_bytes().
+  [[nodiscard]] std::optional<std::string> failure() const { return queue_->failure(); }
+  /// Bytes of lines dropped since the failure.
+  [[nodiscard]] std::uint64_t dropped_bytes() const { return queue_->dropped_bytes(); }
 
   [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
   [[nodiscard]] double time_of(std::uint64_t tick) const { return static_cast<double>(tick) / info_.tick_hz; }
 
  private:
-  void write_session_json();
-  void update_session_json();  // write_session_json, logging a failure instead of throwing
-  void write_buffers();        // throws std::runtime_error when a write fails
-  void report_trouble(const std::string& what);
-
-  // A descriptor closed with its owner, so that a constructor that throws halfway leaks none.
-  struct OwnedFd {
-    int fd = -1;
-    OwnedFd() = default;
-    OwnedFd(const OwnedFd&) = delete;
-    OwnedFd& operator=(const OwnedFd&) = delete;
-    ~OwnedFd();
-  };
+  void hand_over();  // the buffers to the writer thread, followed by a sync
 
   std::filesystem::path dir_;
   SessionInfo info_;
   nlohmann::ordered_json session_;  // session.json as it stands
-  OwnedFd trajectory_fd_, events_fd_;
   std::string trajectory_buffer_, events_buffer_;
   std::uint64_t sample_every_ = 6;
   std::chrono::milliseconds flush_interval_;
   std::chrono::steady_clock::time_point last_flush_;
-  std::optional<std::chrono::steady_clock::time_point> last_trouble_report_;
+  std::unique_ptr<SyncQueue> queue_;  // last: started once the folder is in place
 };
 
 /// Wall-clock time as ISO 8601 UTC with milliseconds: "2026-11-24T10:15:02.250Z".

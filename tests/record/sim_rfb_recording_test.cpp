@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Real sim_rfb processes recording a session: killed with SIGKILL they leave readable files up to their last
-// second; ended with SIGTERM they close session.json with the end; a viewer's connect is recorded hashed.
+// Real sim_rfb processes recording a session: killed with SIGKILL they leave readable files up to two seconds
+// before the kill; ended with SIGTERM they close session.json with the end; a viewer's connect is recorded hashed.
 #include <catch2/catch.hpp>
 
 #include <signal.h>
@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "http_client.hpp"
+#include "record/session_log.hpp"
 #include "rfb_test_client.hpp"
 #include "sim_process.hpp"
 #include "scratch_dir.hpp"
@@ -47,35 +48,43 @@ std::uint64_t current_tick(int port) {
 
 }  // namespace
 
-TEST_CASE("sim_rfb killed with SIGKILL leaves readable session files up to its last second") {
+TEST_CASE("sim_rfb killed with SIGKILL leaves readable session files up to two seconds before the kill") {
   ScratchDir scratch;
   const auto dir = scratch.path() / "killed";
   SimProcess sim(rfbsim::test::sim_rfb_path(),
                  {"--port", "0", "--scenario", "lab", "--data-dir", dir.string(), "--uid", "p-killed"});
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
-  const std::uint64_t tick_before_kill = current_tick(sim.port());
-  REQUIRE(tick_before_kill > 60);
-  ::kill(sim.pid(), SIGKILL);
-  sim.stop(SIGKILL);
+  // A participant walks for a while, so that there are inputs, moves and task events to lose.
+  {
+    rfbsim::test::RfbTestClient client("127.0.0.1", sim.port());
+    REQUIRE(client.wait_for_updates(1, std::chrono::seconds(20)));
+    client.send_key('w', true);
+    client.pump_until([] { return false; }, std::chrono::milliseconds(2500));
+    const std::uint64_t tick_before_kill = current_tick(sim.port());
+    REQUIRE(tick_before_kill > 60);
+    sim.stop(SIGKILL);
 
-  const json session = json::parse(std::ifstream(dir / "session.json"));
-  CHECK(session["uid"] == "p-killed");
-  CHECK(session["ended_at"].is_null());  // it never ended cleanly, and says so
+    // The project's own reader takes the folder as it is (a torn last line is dropped, not an error).
+    const rfbsim::sim::SessionLog log = rfbsim::sim::read_session(dir);
+    CHECK(log.meta.uid == "p-killed");
+    CHECK_FALSE(log.meta.ended_at);  // it never ended cleanly, and says so
+    CHECK_FALSE(log.meta.data_incomplete);
+    REQUIRE_FALSE(log.trajectory.empty());
+    // Lines reach the disk every half second, synced: at most two seconds (120 ticks) before the kill is lost.
+    CHECK(log.trajectory.back().tick + 120 >= tick_before_kill);
+    bool connect_seen = false, timer_seen = false, w_down = false;
+    for (const rfbsim::sim::Event& event : log.events) {
+      connect_seen = connect_seen || (event.type == "client" && event.text("event") == "connect");
+      timer_seen = timer_seen || event.type == "timer";  // a task event: synced when it happened
+      w_down = w_down || (event.type == "key" && event.integer("keysym") == 'w' && event.flag("down"));
+    }
+    CHECK(connect_seen);
+    CHECK(timer_seen);
+    CHECK(w_down);
+  }
+  // And so does a plain line-by-line reader.
   const auto rows = complete_lines(dir / "trajectories.csv");
   REQUIRE(rows.size() > 1);
   CHECK(rows.front() == "tick,time,kind,id,x,y,yaw,vx,vy");
-  std::uint64_t last_tick = 0;
-  for (std::size_t i = 1; i < rows.size(); ++i) {
-    std::stringstream row(rows[i]);
-    std::string field;
-    std::vector<std::string> fields;
-    while (std::getline(row, field, ',')) fields.push_back(field);
-    REQUIRE(fields.size() == 9);
-    last_tick = std::stoull(fields[0]);
-    CHECK(std::isfinite(std::stod(fields[4])));
-  }
-  // Rows reach the file at least twice a second, so at most one second (60 ticks) before the kill is lost.
-  CHECK(last_tick + 60 >= tick_before_kill);
   for (const std::string& line : complete_lines(dir / "events.jsonl")) CHECK_NOTHROW(json::parse(line));
 }
 
