@@ -3,6 +3,7 @@
 
 import { installH264Guard } from './h264_guard.js';
 import RFB from './novnc/core/rfb.js';
+import { SERIES_CALM_MS, classifyClose, nextStep, sessionView } from './reconnect_policy.js';
 import { SurveyReporter } from './survey.js';
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -18,6 +19,9 @@ const ui = {
   panelTitle: document.getElementById('disconnected-title'),
   panelDetail: document.getElementById('disconnected-detail'),
   reconnect: document.getElementById('reconnect'),
+  notice: document.getElementById('reconnecting'),
+  noticeText: document.getElementById('reconnecting-text'),
+  reconnectNow: document.getElementById('reconnect-now'),
 };
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -30,8 +34,13 @@ const state = {
   attempts: 0,            // connection attempts made by this page (1 = the first, no reconnects yet)
   focused: false,         // keyboard focus is on the simulator view (keys reach the simulator)
   desktopName: '',        // name the server gave its desktop
-  lastDisconnect: null,   // { kind: 'ended' | 'lost' | 'failed', final, clean, code, wasClean, reason,
-                          //   sessionState, message }; final: the manager says the session is over for good
+  lastDisconnect: null,   // what the disconnect panel last said: { kind: 'ended' | 'lost' | 'failed' | 'refused' |
+                          //   'taken-over', final, clean, code, wasClean, reason, sessionState, message };
+                          //   final: the manager says the session is over for good
+  reconnecting: false,    // a connection was lost and the page is trying again by itself (see reconnect_policy.js)
+  retries: 0,             // automatic tries in the current series (the notice's "attempt N")
+  reconnects: 0,          // lost connections this page got back by itself (a picture showed again)
+  lastLoss: null,         // { kind, code, reason, at (performance.now()) } of the last connection tried again
   options: null,          // { quality, compression } taken from the query string (null where absent or invalid)
   firstFrameAt: null,     // ms since the navigation started (performance.now()) when a picture was first drawn
   sessionState: null,     // the manager's last word on this session ('starting', 'running', 'ended', ...), or
@@ -48,6 +57,7 @@ window.rfbsimState = state;
 let rfb = null;           // the current noVNC client, or null while disconnected
 let canvas = null;        // that client's canvas (noVNC makes a new one for every client)
 let pictureShown = false; // the current client has drawn its first picture
+let pictureAt = 0;        // performance.now() when it did
 
 // ---------------------------------------------------------------------------------------------------------------
 // Options from the query string: ?quality=0..9&compression=0..9. Anything else is ignored with a warning.
@@ -108,7 +118,6 @@ statusUrl.hash = '';
 const STATUS_POLL_MS = 250;       // while no picture shows, the status is asked for this often
 const OUTCOME_POLL_MS = 1000;     // in a survey, while the session runs: how soon the survey hears the outcome
 const STATUS_TIMEOUT_MS = 2000;   // one status request may take this long
-const LIVE_STATES = new Set(['starting', 'running']);
 
 // Why a session is over, in words, by the state it ended in (the manager's `ends_as`).
 const SESSION_OVER_WORDS = {
@@ -120,11 +129,14 @@ const SESSION_OVER_WORDS = {
   crashed: 'The simulator stopped unexpectedly.',
   failed: 'The simulator could not start.',
   interrupted: 'The session was interrupted.',
+  abandoned: 'The session ended before its picture could reach this browser.',
 };
 // Sessions that did not run their course: the study link starts a new one.
-const RESTARTABLE_STATES = new Set(['shutdown', 'crashed', 'failed', 'interrupted']);
+const RESTARTABLE_STATES = new Set(['shutdown', 'crashed', 'failed', 'interrupted', 'abandoned']);
 
-let statusAvailable = true;  // false once 'status' answered like no manager is there (sim_rfb's 404)
+let statusAvailable = true;  // false once 'status' answered that there is nothing more to ask (see noStatusView)
+let noStatusView = 'none';   // what an unavailable status means: 'none' (sim_rfb's 404) or 'gone' (the manager's)
+let managed = false;         // a manager has answered this page's status at least once
 let statusPolling = false;   // the polling loop runs
 let startingSince = null;    // { elapsedS, at }: the session's start-up time as last reported, and when
 
@@ -132,33 +144,40 @@ function timeoutSignal(ms) {
   return typeof AbortSignal.timeout === 'function' ? AbortSignal.timeout(ms) : undefined;
 }
 
-// Asks for the session's status. Resolves with { state, endsAs, elapsedS }, or null when there is no answer to
-// use (no manager, or the request failed; a failure is tried again by the next poll).
+// Asks for the session's status. Resolves with { view, state, endsAs, elapsedS }: view is reconnect_policy.js's
+// sessionView ('live', 'over', 'gone', 'none' or 'unknown'); the rest are null unless the manager answered.
 async function fetchSessionStatus() {
+  const none = { state: null, endsAs: null, elapsedS: null };
   if (!statusAvailable) {
-    return null;
+    return { ...none, view: noStatusView };
   }
   let response;
   let body = null;
+  let json = false;
   try {
     response = await fetch(statusUrl, { cache: 'no-store', signal: timeoutSignal(STATUS_TIMEOUT_MS) });
     const type = response.headers.get('Content-Type') || '';
     if (type.includes('json')) {
+      json = true;
       body = await response.json();
     }
   } catch (err) {
-    return null;   // network trouble or a body that is not JSON after all: ask again later
+    return { ...none, view: 'unknown' };   // network trouble or a body that is not JSON after all: ask again later
   }
   const valid = response.ok && body !== null && typeof body === 'object' && typeof body.state === 'string';
+  const view = sessionView({ httpStatus: response.status, json, state: valid ? body.state : null, managed });
   if (!valid) {
-    // sim_rfb serving the page itself answers 404 (text); a manager answers JSON. Give up on anything else too,
-    // except server errors, which may pass.
-    if (response.status < 500) {
+    // sim_rfb serving the page itself answers 404 (text); a manager answers JSON, and 404 or 410 once it no longer
+    // knows the session. Either way there is nothing more to ask. Server errors may pass: asked again later.
+    if (view === 'none' || view === 'gone') {
       statusAvailable = false;
+      noStatusView = view;
     }
-    return null;
+    return { ...none, view };
   }
+  managed = true;
   const status = {
+    view,
     state: body.state,
     endsAs: typeof body.ends_as === 'string' ? body.ends_as : body.state,
     elapsedS: Number.isFinite(body.elapsed_s) ? body.elapsed_s : null,
@@ -219,6 +238,11 @@ function showStatus(text, counter = '') {
 // The progress line for where the current attempt stands: starting (with the manager's clock), connecting,
 // loading the first picture, or nothing once the picture shows.
 function showProgress() {
+  if (state.reconnecting) {
+    showStatus('');
+    showReconnecting();
+    return;
+  }
   if (state.recovering) {
     const waited = performance.now() - recoveringSince;
     showStatus(waited >= RECOVERY_NOTICE_MS ? 'Restoring the picture\u2026' : '');
@@ -245,10 +269,24 @@ function updateFocus() {
   ui.hint.hidden = watching || !state.connected || state.focused || state.outcome !== null;
 }
 
-// The panel after a disconnect. `final`: the session is over for good, so there is nothing to reconnect to.
-function showDisconnected(title, message, final) {
+// The notice while the page reconnects by itself: it leaves the (held) picture visible and asks for nothing, and
+// its button tries at once instead of waiting; the text is only set when it changes (one announcement per try).
+function showReconnecting() {
+  const text = `Connection lost, reconnecting\u2026 (attempt ${state.retries})`;
+  if (ui.noticeText.textContent !== text) {
+    ui.noticeText.textContent = text;
+  }
+  ui.reconnectNow.disabled = retryTimer === null;
+  ui.notice.hidden = false;
+}
+
+// The panel after a disconnect. `final`: the session is over for good, so there is nothing to reconnect to;
+// `action`: the button's words where there is something to do.
+function showDisconnected(title, message, final, action = 'Reconnect') {
+  ui.notice.hidden = true;
   ui.panelTitle.textContent = title;
   ui.panelDetail.textContent = message;
+  ui.reconnect.textContent = action;
   ui.reconnect.hidden = final;
   ui.reconnect.disabled = final;
   ui.panel.hidden = false;
@@ -293,7 +331,12 @@ function watchForFirstPicture(client, view) {
 
 function firstPictureShown() {
   pictureShown = true;
-  if (state.recovering) {
+  pictureAt = performance.now();
+  if (state.reconnecting) {
+    state.reconnects += 1;
+    stopReconnecting();
+  }
+  if (state.recovering || heldPicture) {
     endRecovery();
   }
   if (state.firstFrameAt === null) {
@@ -383,7 +426,8 @@ function holdPicture(view) {
   }
 }
 
-// The recovery is over: a new picture shows, or the page says why there is none.
+// The recovery (or a reconnection) is over: a new picture shows, or the page says why there is none. Either way
+// the held picture goes.
 function endRecovery() {
   state.recovering = false;
   clearTimeout(recoveryNoticeTimer);
@@ -402,10 +446,17 @@ function endRecovery() {
 // The socket is opened at once: under sim_manager it is held until the session is ready, so the first frame
 // comes as early as it can; the status is polled meanwhile to show the start-up progress.
 // ---------------------------------------------------------------------------------------------------------------
+// An automatic try that has not connected after this long is given up (and counts as failed): a network that
+// swallows packets would otherwise leave the socket opening for minutes. First attempts have no limit, because
+// the manager holds their socket while the session starts.
+const RETRY_CONNECT_TIMEOUT_MS = 15_000;
+
 function connect({ focusWhenConnected = false } = {}) {
   if (state.connecting || state.connected) {
     return;
   }
+  clearTimeout(retryTimer);
+  retryTimer = null;
   state.attempts += 1;
   state.connecting = true;
   pictureShown = false;
@@ -413,8 +464,10 @@ function connect({ focusWhenConnected = false } = {}) {
   showProgress();
   updateFocus();
 
-  // Open the WebSocket ourselves so that the close code is known when noVNC reports the disconnect.
-  const closeInfo = { code: null, wasClean: false, reason: '' };
+  // Open the WebSocket ourselves so that the close code is known when noVNC reports the disconnect. Its close
+  // event comes before noVNC's (registered first), while the view still has the keyboard focus it had.
+  const closeInfo = { code: null, wasClean: false, reason: '', hadFocus: false };
+  let view = null;
   let socket;
   try {
     socket = new WebSocket(websocketUrl());
@@ -426,6 +479,7 @@ function connect({ focusWhenConnected = false } = {}) {
     closeInfo.code = event.code;
     closeInfo.wasClean = event.wasClean;
     closeInfo.reason = event.reason;
+    closeInfo.hadFocus = view !== null && document.activeElement === view;
   });
 
   let client;
@@ -447,7 +501,7 @@ function connect({ focusWhenConnected = false } = {}) {
   client.showDotCursor = true;
   client.viewOnly = watching;
   // While a frozen picture is held behind the view (see holdPicture), the view lets it show until it has its own.
-  client.background = state.recovering ? 'transparent' : '#1e1e1e';
+  client.background = heldPicture ? 'transparent' : '#1e1e1e';
   if (options.quality !== null) {
     client.qualityLevel = options.quality;
   }
@@ -457,6 +511,7 @@ function connect({ focusWhenConnected = false } = {}) {
 
   // The canvas: reachable with Tab, announced to screen readers, and watched for focus and the first picture.
   canvas = ui.screen.querySelector('canvas');
+  view = canvas;
   if (canvas !== null) {
     canvas.tabIndex = 0;
     canvas.setAttribute('role', 'application');
@@ -468,9 +523,16 @@ function connect({ focusWhenConnected = false } = {}) {
   }
 
   let securityReason = '';
+  let refused = false;
   let wasConnected = false;
+  let gaveUp = false;
+  const giveUpTimer = state.reconnecting ? setTimeout(() => {
+    gaveUp = true;
+    client.disconnect();
+  }, RETRY_CONNECT_TIMEOUT_MS) : null;
 
   client.addEventListener('connect', () => {
+    clearTimeout(giveUpTimer);
     wasConnected = true;
     state.connecting = false;
     state.connected = true;
@@ -489,36 +551,77 @@ function connect({ focusWhenConnected = false } = {}) {
 
   client.addEventListener('credentialsrequired', () => {
     securityReason = 'The simulator asked for a password, which this page does not support.';
+    refused = true;
     client.disconnect();
   });
 
   client.addEventListener('securityfailure', (event) => {
     securityReason = event.detail.reason ? `The simulator refused the connection: ${event.detail.reason}` : '';
+    refused = true;
   });
 
   client.addEventListener('disconnect', (event) => {
+    clearTimeout(giveUpTimer);
     const clean = Boolean(event.detail && event.detail.clean);
-    let kind;
-    if (!wasConnected) {
-      kind = 'failed';
-    } else if (clean && (closeInfo.code === null || closeInfo.code === 1000 || closeInfo.code === 1001 ||
-                        closeInfo.code === 1005)) {
-      kind = 'ended';
-    } else {
-      kind = 'lost';
-    }
+    const kind = classifyClose({ connected: wasConnected, clean, code: closeInfo.code, refused, gaveUp });
     finishAttempt({ kind, clean, code: closeInfo.code, wasClean: closeInfo.wasClean,
-                    reason: securityReason || closeInfo.reason });
+                    reason: securityReason || closeInfo.reason },
+                  { view, hadFocus: closeInfo.hadFocus });
   });
 }
 
+// ---------------------------------------------------------------------------------------------------------------
+// Reconnecting by itself after a lost connection (the rule is reconnect_policy.js's): the last picture stays on
+// screen with a notice over it, tries follow with growing waits for as long as the session is alive, and the
+// first new picture ends it all; keys reach the view again if it had them when the connection was lost.
+// ---------------------------------------------------------------------------------------------------------------
+let retryTimer = null;    // the wait before the next automatic try, or null
+let retryFocus = false;   // the view gets the keyboard back once a try connects
+
+// The next try, after delayMs; `loss` is the attempt that just ended ({ info, view, hadFocus, hadPicture }).
+function scheduleRetry(retry, delayMs, { info, view, hadFocus, hadPicture }) {
+  if (!state.reconnecting) {
+    state.reconnecting = true;
+    state.lastLoss = { kind: info.kind, code: info.code, reason: info.reason, at: performance.now() };
+    if (hadPicture && !heldPicture) {
+      holdPicture(view);
+    }
+  }
+  // A picture failure whose new connection did not get through is a lost connection now.
+  state.recovering = false;
+  clearTimeout(recoveryNoticeTimer);
+  retryFocus = retryFocus || hadFocus;
+  state.retries = retry;
+  clearTimeout(retryTimer);
+  retryTimer = setTimeout(retryNow, delayMs);
+  showProgress();
+}
+
+function retryNow() {
+  clearTimeout(retryTimer);
+  retryTimer = null;
+  connect({ focusWhenConnected: retryFocus });
+}
+
+// Reconnecting is over: a picture is back, or the page shows why there will be none.
+function stopReconnecting() {
+  clearTimeout(retryTimer);
+  retryTimer = null;
+  state.reconnecting = false;
+  retryFocus = false;
+  ui.notice.hidden = true;
+}
+
 // Called once per attempt when it is over: forget the client, ask the manager (if any) whether the session is
-// over for good, and say what happened.
-async function finishAttempt(info) {
+// over for good, and then try again, or say what happened. `view` and `hadFocus`: the attempt's canvas, and
+// whether it had the keyboard when the connection closed.
+async function finishAttempt(info, { view = null, hadFocus = false } = {}) {
   if (canvas !== null) {
     canvas.removeEventListener('focus', updateFocus);
     canvas.removeEventListener('blur', updateFocus);
   }
+  const hadPicture = pictureShown;
+  const upMs = pictureShown ? performance.now() - pictureAt : 0;
   // The connection's decoders are gone with it: nothing they do from now on is a failure of the next one.
   h264Guard.retire();
   rfb = null;
@@ -528,18 +631,25 @@ async function finishAttempt(info) {
   showStatus('');
   updateFocus();
 
-  // Over for good when the manager says the session is neither starting nor running: a reconnect cannot help.
+  // Over for good when the manager says the session is neither starting nor running, or no longer knows it: a
+  // reconnect cannot help.
   const session = await fetchSessionStatus();
-  if (session !== null && !LIVE_STATES.has(session.state)) {
-    let message = SESSION_OVER_WORDS[session.endsAs] || `The session is over (${session.endsAs}).`;
-    if (RESTARTABLE_STATES.has(session.endsAs)) {
-      message += ' Opening your study link again starts a new session.';
+  if (session.view === 'over' || session.view === 'gone') {
+    let message;
+    if (session.view === 'gone') {
+      message = 'This session is no longer available on the server.';
+    } else {
+      message = SESSION_OVER_WORDS[session.endsAs] || `The session is over (${session.endsAs}).`;
+      if (RESTARTABLE_STATES.has(session.endsAs)) {
+        message += ' Opening your study link again starts a new session.';
+      }
     }
     if (state.completionCode !== null) {
       message += ` Your completion code: ${state.completionCode}`;
     }
     survey.ended();
     recovery = null;
+    stopReconnecting();
     endRecovery();
     state.lastDisconnect = { ...info, kind: 'ended', final: true, sessionState: session.state, message };
     showDisconnected('Session ended', message, true);
@@ -554,14 +664,36 @@ async function finishAttempt(info) {
     setTimeout(() => connect({ focusWhenConnected: focus }), delayMs);
     return;
   }
+
+  // A lost connection: try again by itself. A connection that showed a picture long enough ended the last series
+  // of tries, so a new loss starts from the shortest wait.
+  if (!state.reconnecting && hadPicture && upMs >= SERIES_CALM_MS) {
+    state.retries = 0;
+  }
+  const step = nextStep({ kind: info.kind, session: session.view, retries: state.retries });
+  if (step.action === 'retry') {
+    scheduleRetry(step.retry, step.delayMs, { info, view, hadFocus, hadPicture });
+    return;
+  }
+  stopReconnecting();
   endRecovery();
 
   let title;
   let message;
+  let action = 'Reconnect';
   switch (info.kind) {
+    case 'taken-over':
+      title = 'Opened elsewhere';
+      message = 'This session was opened in another window or tab.';
+      action = 'Use it here';
+      break;
     case 'ended':
       title = 'Session ended';
       message = 'The simulator closed the connection.';
+      break;
+    case 'refused':
+      title = 'Connection refused';
+      message = 'The simulator refused the connection.';
       break;
     case 'lost':
       title = 'Connection lost';
@@ -572,20 +704,42 @@ async function finishAttempt(info) {
       message = 'The simulator could not be reached. It may have stopped, or the network may be down.';
       break;
   }
-  if (info.reason) {
-    message += ` (${info.reason})`;
+  if (info.kind === 'taken-over') {
+    message += ' Press \u201cUse it here\u201d to continue in this window (the other one then stops).';
+  } else {
+    if (info.reason) {
+      message += ` (${info.reason})`;
+    }
+    message += ' Press Reconnect to try again.';
   }
-  message += ' Press Reconnect to try again.';
-  state.lastDisconnect = { ...info, final: false, sessionState: session ? session.state : null, message };
-  showDisconnected(title, message, false);
+  state.lastDisconnect = { ...info, final: false, sessionState: session.state, message };
+  showDisconnected(title, message, false, action);
 }
 
 // ---------------------------------------------------------------------------------------------------------------
 // Wiring.
 // ---------------------------------------------------------------------------------------------------------------
+// The panel's button: one attempt at the person's word (after the tries ran out, a refusal, or a takeover), and a
+// new series of tries should it fail.
 ui.reconnect.addEventListener('click', () => {
   ui.reconnect.disabled = true;
+  state.retries = 0;
   connect({ focusWhenConnected: true });
+});
+
+// The notice's button: the next try now rather than after its wait.
+ui.reconnectNow.addEventListener('click', () => {
+  if (retryTimer !== null) {
+    retryFocus = true;
+    retryNow();
+  }
+});
+
+// The browser saw the network come back: no reason to sit out the rest of a wait.
+window.addEventListener('online', () => {
+  if (retryTimer !== null) {
+    retryNow();
+  }
 });
 
 // A click on the letterbox around the picture also gives the view the keyboard (noVNC only listens on the
