@@ -10,6 +10,8 @@
 #include <functional>
 #include <map>
 
+#include "client_address.hpp"
+#include "launch_plan.hpp"
 #include "start_request.hpp"
 
 namespace rfbsim::manager {
@@ -50,6 +52,23 @@ Apply seconds(std::chrono::seconds ManagerConfig::*field, long long low) {
       return "expected whole seconds " + std::to_string(low) + ".." + std::to_string(7 * 24 * 3600);
     }
     c.*field = std::chrono::seconds(value);
+    return "";
+  };
+}
+
+// An integer field of the abuse limits.
+Apply abuse_integer(int AbuseLimits::*field, int high) {
+  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+    if (!parse_integer(v.front(), 0, high, c.abuse.*field)) return "expected 0.." + std::to_string(high) + ", 0 = off";
+    return "";
+  };
+}
+
+Apply abuse_seconds(std::chrono::seconds AbuseLimits::*field) {
+  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+    long long value = 0;
+    if (!parse_integer(v.front(), 0LL, 3600LL, value)) return "expected whole seconds 0..3600, 0 = off";
+    c.abuse.*field = std::chrono::seconds(value);
     return "";
   };
 }
@@ -190,6 +209,32 @@ const std::map<std::string, Setting>& settings() {
          c.limits.cpu_time_factor = factor;
          return "";
        }}},
+      {"rate_start_per_minute", {false, abuse_integer(&AbuseLimits::start_per_minute, 1000000)}},
+      {"rate_start_burst", {false, abuse_integer(&AbuseLimits::start_burst, 1000000)}},
+      {"rate_upgrade_per_minute", {false, abuse_integer(&AbuseLimits::upgrade_per_minute, 1000000)}},
+      {"rate_upgrade_burst", {false, abuse_integer(&AbuseLimits::upgrade_burst, 1000000)}},
+      {"max_connections_per_address", {false, abuse_integer(&AbuseLimits::connections_per_address, 1000000)}},
+      {"max_connections", {false, abuse_integer(&AbuseLimits::connections_total, 1000000)}},
+      {"max_unspent_sessions_per_address", {false, abuse_integer(&AbuseLimits::unspent_sessions_per_address, 1000000)}},
+      {"ws_ping_interval_s", {false, abuse_seconds(&AbuseLimits::ws_ping_interval)}},
+      {"ws_pong_timeout_s", {false, abuse_seconds(&AbuseLimits::ws_pong_timeout)}},
+      {"trusted_proxies", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         for (const std::string& entry : v) {
+           if (!parse_address_range(entry)) return "'" + entry + "' is not an address or CIDR range such as 10.0.0.0/8";
+         }
+         c.trusted_proxies = v;
+         return "";
+       }}},
+      {"on_data_incomplete", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.front() == "continue") {
+           c.on_data_incomplete = DataFailurePolicy::kContinue;
+         } else if (v.front() == "end") {
+           c.on_data_incomplete = DataFailurePolicy::kEnd;
+         } else {
+           return "expected continue or end";
+         }
+         return "";
+       }}},
       {"limit_cpu_slack_s", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          long long value = 0;
          if (!parse_integer(v.front(), 0LL, 86400LL, value)) return "expected whole seconds 0..86400";
@@ -261,6 +306,15 @@ std::string manager_usage() {
          "  --public-url ORIGIN     this host's public origin; /start redirects there (several hosts)\n"
          "  --limit-address-space-mb N, --limit-open-files N, --limit-cpu-time-factor F, --limit-cpu-slack-s S\n"
          "                          per-session resource limits (0 = none)\n"
+         "  --rate-start-per-minute N, --rate-start-burst N (default 20, 10), --rate-upgrade-per-minute N,\n"
+         "  --rate-upgrade-burst N (default 60, 30)   per-address rate limits on /start and WebSocket upgrades\n"
+         "                          (429 with Retry-After; 0 = off; every address, loopback included)\n"
+         "  --max-connections-per-address N (default 64), --max-connections N (default: from the descriptor limit)\n"
+         "  --max-unspent-sessions-per-address N   live sessions one address started that no participant has\n"
+         "                          seen yet (default 3)\n"
+         "  --ws-ping-interval-s S, --ws-pong-timeout-s S   WebSocket keep-alive (default 20, 20; 0 = off)\n"
+         "  --trusted-proxies A,B   front ends whose X-Forwarded-For names the participant (addresses or CIDR)\n"
+         "  --on-data-incomplete continue|end   when a session's data cannot be written (default continue)\n"
          "  --sign QUERY            print QUERY with its link signature (needs a link secret) and exit\n";
 }
 
@@ -401,6 +455,10 @@ std::string validate_config(const ManagerConfig& config) {
     bool has_port = false;
     for (const std::string& arg : config.session_args) has_port = has_port || arg.find("{port}") != std::string::npos;
     if (!has_port) return "session_kind rfb needs {port} in session_args, where the program is told its port";
+  }
+  // The manager's own flags (where the session listens, its data folder...) are not the config's to change.
+  if (std::string problem = session_args_problem(config.session_args, config.session_kind); !problem.empty()) {
+    return problem;
   }
   return "";
 }

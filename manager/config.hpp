@@ -35,6 +35,26 @@ struct ProcessLimits {
   std::chrono::seconds cpu_slack{60};
 };
 
+/// Limits against abuse of the public port. They apply to every client address, loopback included; a lab
+/// whose participants share one address (one NAT) raises them. 0 switches a limit off.
+struct AbuseLimits {
+  int start_per_minute = 20;       ///< /start requests per address per minute, sustained
+  int start_burst = 10;            ///< /start requests per address at once
+  int upgrade_per_minute = 60;     ///< WebSocket upgrades per address per minute, sustained (reconnects)
+  int upgrade_burst = 30;          ///< WebSocket upgrades per address at once
+  int connections_per_address = 64;   ///< open connections per address
+  int connections_total = 0;          ///< open connections in all; 0 = from the descriptor limit (see frontend)
+  int unspent_sessions_per_address = 3;  ///< live sessions started from one address whose link is not yet spent
+  std::chrono::seconds ws_ping_interval{20};  ///< a ping to every WebSocket this often
+  std::chrono::seconds ws_pong_timeout{20};   ///< a WebSocket whose pong is this late is closed
+};
+
+/// What happens when a session's data can no longer be written (a full disk): the program reports it.
+enum class DataFailurePolicy {
+  kContinue,  ///< the participant carries on; the session is marked data_incomplete in the index
+  kEnd,       ///< the session ends (the page says so and offers the way back to the survey)
+};
+
 /// Everything sim_manager can be configured with; start from the defaults.
 struct ManagerConfig {
   std::string listen_address = "127.0.0.1";  ///< numeric IPv4 address; loopback unless told otherwise
@@ -64,6 +84,10 @@ struct ManagerConfig {
   /// so that a load balancer can hand new links to any host and the session stays with its host.
   std::string public_url;
   ProcessLimits limits;
+  AbuseLimits abuse;
+  /// Front ends (nginx, HAProxy) whose X-Forwarded-For names the participant: addresses or CIDR ranges.
+  std::vector<std::string> trusted_proxies;
+  DataFailurePolicy on_data_incomplete = DataFailurePolicy::kContinue;
 };
 
 /// The outcome of reading settings: a config, or a message naming the file, line or flag at fault.

@@ -3,7 +3,11 @@
 // Compiled as C++17 (websocketpp 0.8.2 does not build as C++20 with g++ 12).
 #include "frontend.hpp"
 
+#include <sys/resource.h>
+
+#include <algorithm>
 #include <boost/asio/ssl/context.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -11,10 +15,13 @@
 #include <websocketpp/config/asio.hpp>
 #include <websocketpp/server.hpp>
 
+#include "client_address.hpp"
+#include "connection_limits.hpp"
 #include "link_signature.hpp"
 #include "pages.hpp"
 #include "proxy_line.hpp"
 #include "query.hpp"
+#include "rate_limiter.hpp"
 #include "relay.hpp"
 #include "routes.hpp"
 #include "session_views.hpp"
@@ -39,6 +46,39 @@ constexpr int kAdminRecentSessions = 200;
 // After a session's socket closes, how long to wait for the process's exit to say why, before telling the
 // browser the connection was lost.
 constexpr auto kUpstreamLostGrace = std::chrono::milliseconds(300);
+// After a failed accept (EMFILE: no descriptor left), how long to wait before the next: accepting at once
+// would fail at once again, a busy loop on the I/O thread that every session's relay shares.
+constexpr auto kAcceptPause = std::chrono::milliseconds(100);
+// Descriptors kept free of public connections for the manager itself: the index, logs, and per live session
+// its relays' upstream sockets, its ready pipe and its spawn.
+constexpr std::size_t kReservedDescriptors = 64;
+constexpr std::size_t kDescriptorsPerSession = 8;
+// The close code and reason an earlier browser gets when a newer one of the same session takes over (the page
+// shows it and does not reconnect by itself, or two tabs would take turns).
+constexpr int kTakenOverCode = 4001;
+constexpr const char* kTakenOverReason = "opened in another window";
+// How often a refusal at accept is logged at most: a flood must not become a flood of log lines.
+constexpr auto kRefusalLogInterval = std::chrono::seconds(10);
+
+// Public connections allowed at once: the configured cap, or what the descriptor limit leaves after the
+// manager's own needs.
+std::size_t total_connection_cap(const ManagerConfig& config) {
+  if (config.abuse.connections_total > 0) return static_cast<std::size_t>(config.abuse.connections_total);
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_NOFILE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return 4096;
+  const std::size_t reserved =
+      kReservedDescriptors + kDescriptorsPerSession * static_cast<std::size_t>(config.max_sessions);
+  const auto available = static_cast<std::size_t>(limit.rlim_cur);
+  return available > reserved + 16 ? available - reserved : 16;
+}
+
+std::vector<AddressRange> parse_trusted(const std::vector<std::string>& entries) {
+  std::vector<AddressRange> ranges;
+  for (const std::string& entry : entries) {
+    if (const auto range = parse_address_range(entry)) ranges.push_back(*range);
+  }
+  return ranges;
+}
 
 // websocketpp's close call for a session's notice.
 template <typename Connection>
@@ -78,7 +118,19 @@ class FrontendImpl final : public Frontend, public SessionListener {
 
   FrontendImpl(asio::io_context& io, const ManagerConfig& config, Supervisor& supervisor, Metrics& metrics,
                std::string web_root, bool tls)
-      : io_(io), config_(config), supervisor_(supervisor), metrics_(metrics), web_root_(std::move(web_root)), tls_(tls) {
+      : io_(io),
+        config_(config),
+        supervisor_(supervisor),
+        metrics_(metrics),
+        web_root_(std::move(web_root)),
+        tls_(tls),
+        connection_limits_(static_cast<std::size_t>(config.abuse.connections_per_address), total_connection_cap(config)),
+        start_limiter_({static_cast<double>(config.abuse.start_per_minute), static_cast<double>(config.abuse.start_burst)}),
+        upgrade_limiter_(
+            {static_cast<double>(config.abuse.upgrade_per_minute), static_cast<double>(config.abuse.upgrade_burst)}),
+        trusted_proxies_(parse_trusted(config.trusted_proxies)),
+        accept_pause_(io),
+        ping_timer_(io) {
     server_.clear_access_channels(websocketpp::log::alevel::all);
     server_.clear_error_channels(websocketpp::log::elevel::all);
     server_.init_asio(&io_);
@@ -105,6 +157,17 @@ class FrontendImpl final : public Frontend, public SessionListener {
       const auto it = relays_.find(hdl);
       if (it != relays_.end()) it->second->from_browser(std::move(message->get_raw_payload()));
     });
+    // A browser that stopped answering (a laptop closed, a network gone without a FIN) is found by its missing
+    // pong, not after TCP's retransmissions give up many minutes later.
+    if (config_.abuse.ws_pong_timeout.count() > 0) {
+      server_.set_pong_timeout(static_cast<long>(config_.abuse.ws_pong_timeout.count()) * 1000);
+      server_.set_pong_timeout_handler([this](connection_hdl hdl, std::string) {
+        metrics_.count_pong_timeout();
+        websocketpp::lib::error_code ec;
+        auto con = server_.get_con_from_hdl(hdl, ec);
+        if (!ec) con->close(websocketpp::close::status::going_away, "no answer to ping", ec);
+      });
+    }
     supervisor_.set_listener(this);
   }
 
@@ -122,8 +185,9 @@ class FrontendImpl final : public Frontend, public SessionListener {
       throw std::runtime_error("cannot listen on " + config_.listen_address + ":" + std::to_string(config_.port) +
                                ": " + ec.message());
     }
-    server_.start_accept(ec);
-    if (ec) throw std::runtime_error("cannot accept connections: " + ec.message());
+    listening_ = true;
+    accept_next();
+    ping_relays_later();
   }
 
   int port() const override {
@@ -135,9 +199,113 @@ class FrontendImpl final : public Frontend, public SessionListener {
 
   void stop() override {
     websocketpp::lib::error_code ec;
+    listening_ = false;
+    accept_pause_.cancel();
+    ping_timer_.cancel();
     server_.stop_listening(ec);
     auto relays = relays_;
     for (auto& [hdl, relay] : relays) relay->close(websocketpp::close::status::going_away, "server shutting down");
+  }
+
+  // ------------------------------------------------------------------------------------------------------
+  // Accepting: our own loop instead of websocketpp's, which accepts again at once after an error and so spins
+  // on EMFILE, and knows nothing of per-address caps.
+  // ------------------------------------------------------------------------------------------------------
+  void accept_next() {
+    if (!listening_) return;
+    ConnectionPtr con = server_.get_connection();
+    if (!con) {
+      pause_accepting("cannot make a connection object");
+      return;
+    }
+    websocketpp::lib::error_code ec;
+    server_.async_accept(con, [this, con](const websocketpp::lib::error_code& accept_ec) { accepted(con, accept_ec); },
+                         ec);
+    if (ec) pause_accepting(ec.message());
+  }
+
+  void pause_accepting(const std::string& why) {
+    metrics_.count_accept_error();
+    if (!accept_paused_) {
+      std::fprintf(stderr, "[manager] accepting connections failed (%s); pausing %lld ms between tries\n", why.c_str(),
+                   static_cast<long long>(kAcceptPause.count()));
+    }
+    accept_paused_ = true;
+    accept_pause_.expires_after(kAcceptPause);
+    accept_pause_.async_wait([this](const boost::system::error_code& ec) {
+      if (!ec) accept_next();
+    });
+  }
+
+  void accepted(const ConnectionPtr& con, const websocketpp::lib::error_code& ec) {
+    if (ec) {
+      websocketpp::lib::error_code ignored;
+      con->terminate(ignored);
+      if (ec == websocketpp::error::operation_canceled || !listening_) return;
+      pause_accepting(ec.message());  // EMFILE and the like: the next accept would fail at once too
+      return;
+    }
+    if (accept_paused_) {
+      std::fprintf(stderr, "[manager] accepting connections again\n");
+      accept_paused_ = false;
+    }
+    admit_connection(con);
+    accept_next();
+  }
+
+  // Counts the connection against its address's cap and the total, or closes it at once. A trusted front
+  // end carries many participants on one address: it counts in the total only.
+  void admit_connection(const ConnectionPtr& con) {
+    boost::system::error_code ec;
+    auto& socket = con->get_raw_socket().lowest_layer();
+    const auto remote = socket.remote_endpoint(ec);
+    if (ec) {
+      socket.close(ec);
+      return;
+    }
+    const std::string peer = remote.address().to_string();
+    const auto parsed = parse_address(peer);
+    const bool trusted = parsed && std::any_of(trusted_proxies_.begin(), trusted_proxies_.end(),
+                                               [&](const AddressRange& range) { return range_contains(range, *parsed); });
+    const std::string key = trusted ? std::string("trusted proxy") : (parsed ? address_text(*parsed) : peer);
+    const bool allowed = trusted ? connection_limits_.try_open_uncapped(key) : connection_limits_.try_open(key);
+    if (!allowed) {
+      metrics_.count_rejection(Rejection::kConnectionLimit);
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_refusal_log_ >= kRefusalLogInterval) {
+        last_refusal_log_ = now;
+        std::fprintf(stderr, "[manager] refused connections over the cap (%zu open, %zu from %s)\n",
+                     connection_limits_.open_total(), connection_limits_.open(key), key.c_str());
+      }
+      socket.close(ec);
+      return;
+    }
+    // Released when websocketpp is done with the connection, whichever way it ends.
+    con->set_termination_handler([this, key](ConnectionPtr) { connection_limits_.closed(key); });
+    con->start();
+  }
+
+  // The address limits and logs use: the peer, or the participant a trusted front end names.
+  std::string client_address_of(const ConnectionPtr& con) {
+    boost::system::error_code ec;
+    const auto remote = con->get_raw_socket().lowest_layer().remote_endpoint(ec);
+    if (ec) return "unknown";
+    return client_address(remote.address().to_string(), con->get_request_header("X-Forwarded-For"), trusted_proxies_);
+  }
+
+  // A ping to every relay's browser; the pong timeout (set above) closes those that do not answer.
+  void ping_relays_later() {
+    if (config_.abuse.ws_ping_interval.count() <= 0 || config_.abuse.ws_pong_timeout.count() <= 0) return;
+    ping_timer_.expires_after(config_.abuse.ws_ping_interval);
+    ping_timer_.async_wait([this](const boost::system::error_code& ec) {
+      if (ec || !listening_) return;
+      for (const auto& entry : relays_) {
+        websocketpp::lib::error_code ping_ec;
+        auto con = server_.get_con_from_hdl(entry.first, ping_ec);
+        if (!ping_ec && con->get_state() == websocketpp::session::state::open) con->ping("", ping_ec);
+      }
+      ping_relays_later();
+    });
   }
 
   // SessionListener
@@ -196,7 +364,15 @@ class FrontendImpl final : public Frontend, public SessionListener {
     const Route route = route_request(con->get_request().get_method(), target);
     switch (route.kind) {
       case RouteKind::kHome: respond_page(con, 200, home_page()); return;
-      case RouteKind::kStart: handle_start(con, route); return;
+      case RouteKind::kStart:
+        // A HEAD (link previews, mail scanners) learns that the link exists and starts nothing.
+        if (con->get_request().get_method() == "HEAD") {
+          metrics_.count_rejection(Rejection::kHead);
+          respond(con, 200, "", "text/html; charset=utf-8", page_headers(config_.frame_origins));
+          return;
+        }
+        handle_start(con, route);
+        return;
       case RouteKind::kSessionFile: handle_session_file(con, route, page_headers(config_.frame_origins)); return;
       case RouteKind::kSessionStatus: handle_session_status(con, route, config_.frame_origins); return;
       case RouteKind::kSessionSocket:
@@ -220,6 +396,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
                                    ",\"capacity\":" + std::to_string(config_.max_sessions) + "}");
         return;
       case RouteKind::kMetrics:
+        metrics_.set_connections(connection_limits_.open_total(), connection_limits_.addresses());
         respond(con, 200,
                 metrics_.render(supervisor_.counts_by_state(), config_.max_sessions, relay_counts(), session_streams()),
                 "text/plain; version=0.0.4; charset=utf-8");
@@ -239,6 +416,14 @@ class FrontendImpl final : public Frontend, public SessionListener {
   }
 
   void handle_start(const ConnectionPtr& con, const Route& route) {
+    const std::string address = client_address_of(con);
+    const auto decision = start_limiter_.take(address, std::chrono::steady_clock::now());
+    if (!decision.allowed) {
+      metrics_.count_rejection(Rejection::kRateLimited);
+      respond_page(con, 429, busy_page(static_cast<int>(decision.retry_after.count())),
+                   {{"Retry-After", std::to_string(decision.retry_after.count())}});
+      return;
+    }
     std::string error;
     const auto params = parse_query(route.query, error);
     if (!params) {
@@ -256,7 +441,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
       refuse(con, 400, Rejection::kBadRequest, "This link is not valid", parsed.error);
       return;
     }
-    const StartOutcome outcome = supervisor_.start(*parsed.request);
+    const StartOutcome outcome = supervisor_.start(*parsed.request, address);
     switch (outcome.kind) {
       case StartOutcome::Kind::kJoined:
       case StartOutcome::Kind::kStarted: {
@@ -273,6 +458,13 @@ class FrontendImpl final : public Frontend, public SessionListener {
         metrics_.count_rejection(Rejection::kCompleted);
         respond_page(con, 409, completed_page());
         return;
+      case StartOutcome::Kind::kTooManyUnspent: {
+        // Sessions nobody opened yet end at the idle timeout, or are spent once their participant shows up.
+        metrics_.count_rejection(Rejection::kUnspentLimit);
+        const auto retry = std::max<long long>(1, std::min<long long>(config_.idle_timeout.count(), 60));
+        respond_page(con, 429, busy_page(static_cast<int>(retry)), {{"Retry-After", std::to_string(retry)}});
+        return;
+      }
       case StartOutcome::Kind::kFailed:
         respond_page(con, 503, error_page(503, "The simulation could not start",
                                           "Something went wrong on our side. Please try the link again in a "
@@ -399,6 +591,11 @@ class FrontendImpl final : public Frontend, public SessionListener {
   }
 
   bool validate_websocket(const ConnectionPtr& con) {
+    const auto decision = upgrade_limiter_.take(client_address_of(con), std::chrono::steady_clock::now());
+    if (!decision.allowed) {
+      con->replace_header("Retry-After", std::to_string(decision.retry_after.count()));
+      return reject_websocket(con, 429, Rejection::kRateLimited, "too many connection attempts; try again later");
+    }
     const std::string& target = con->get_resource();
     if (target.size() > kMaxTarget) return reject_websocket(con, 414, Rejection::kBadRequest, "address too long");
     const Route route = route_request(con->get_request().get_method(), target);
@@ -456,8 +653,14 @@ class FrontendImpl final : public Frontend, public SessionListener {
       close_with(*con, ended ? coming_state(*ended) : SessionState::kCrashed);
       return;
     }
+    // One participant browser per session: the newest wins (a refresh, a second tab, a reconnect after a blip
+    // whose old socket has not timed out yet), and the earlier one is told why, so that it does not retry.
+    if (kind == RelayKind::kParticipant) take_over_from_earlier(*session);
     auto relay = std::make_shared<RelayT>(server_, hdl, session->id, session->token, kind, metrics_,
                                           [this](RelayT& lost) { upstream_lost(lost); });
+    if (kind == RelayKind::kParticipant) {
+      relay->on_picture_delivered([this](RelayT& delivered) { supervisor_.picture_delivered(delivered.session_id()); });
+    }
     relays_[hdl] = relay;
     metrics_.count_relay_open(kind);
     // Only the participant counts as connected: a researcher watching must not keep an idle session alive.
@@ -475,6 +678,17 @@ class FrontendImpl final : public Frontend, public SessionListener {
     relays_.erase(it);
     relay->browser_gone();
     if (relay->kind() == RelayKind::kParticipant) supervisor_.client_disconnected(relay->session_id());
+  }
+
+  void take_over_from_earlier(const Session& session) {
+    auto relays = relays_;  // closing calls back into forget_websocket
+    for (auto& [hdl, relay] : relays) {
+      if (relay->session_id() != session.id || relay->kind() != RelayKind::kParticipant) continue;
+      metrics_.count_takeover();
+      std::fprintf(stderr, "[manager] session %lld (uid %s): a newer browser took over; the earlier one is told\n",
+                   static_cast<long long>(session.id), session.uid.c_str());
+      relay->close(static_cast<websocketpp::close::status::value>(kTakenOverCode), kTakenOverReason);
+    }
   }
 
   // Live sessions' streams as sim_rfb last reported them, for the per-session gauges.
@@ -523,6 +737,15 @@ class FrontendImpl final : public Frontend, public SessionListener {
     RelayKind kind = RelayKind::kParticipant;
   };
   std::map<connection_hdl, Pending, std::owner_less<connection_hdl>> pending_;
+  ConnectionLimits connection_limits_;
+  RateLimiter start_limiter_;
+  RateLimiter upgrade_limiter_;
+  std::vector<AddressRange> trusted_proxies_;
+  asio::steady_timer accept_pause_;
+  asio::steady_timer ping_timer_;
+  bool listening_ = false;
+  bool accept_paused_ = false;
+  std::chrono::steady_clock::time_point last_refusal_log_{};
 };
 
 // TLS settings for the public port: TLS 1.2 and later, the certificate chain and key loaded once, now,

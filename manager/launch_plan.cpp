@@ -30,6 +30,36 @@ std::string expand(const std::string& text, const std::vector<std::pair<std::str
 
 }  // namespace
 
+// Where sim_rfb listens and how it reports (--bind, --port, --unix-socket, --ready-fd, --rfb-only,
+// --web-root, --proxy-protocol) decide who can reach a participant's session and whether the relay's
+// PROXY line is trusted; where it records and as whom (--data-dir, --uid) and with what (--scenario,
+// --seed, --codec) are what the index says of the session. None may come from anywhere but the manager.
+// --allow-origin is not the manager's, but would only open a session to pages other than through the
+// relay, which checks the Origin itself.
+const std::vector<std::string> kManagerFlags = {"--bind",     "--port",     "--unix-socket", "--ready-fd",
+                                                "--rfb-only", "--web-root", "--proxy-protocol",
+                                                "--data-dir", "--uid",      "--scenario",    "--seed",
+                                                "--codec",    "--allow-origin"};
+
+std::string session_args_problem(const std::vector<std::string>& session_args, SessionKind kind) {
+  if (kind != SessionKind::kSimRfb) return "";
+  for (const std::string& arg : session_args) {
+    const std::string flag = arg.substr(0, arg.find('='));
+    if (std::find(kManagerFlags.begin(), kManagerFlags.end(), flag) == kManagerFlags.end()) continue;
+    if (flag == "--allow-origin") {
+      return "session_args: --allow-origin cannot be given there: sessions are reached only through sim_manager's "
+             "relay, which checks the Origin itself (see frame_origins)";
+    }
+    // Where the setting belongs instead, for those that have a place.
+    const std::string where = flag == "--codec"      ? " (use the codec setting)"
+                              : flag == "--scenario" ? " (use the scenarios setting and the link's scenario)"
+                              : flag == "--seed"     ? " (the link's seed parameter sets it)"
+                                                     : "";
+    return "session_args: " + flag + " is set by sim_manager for every session and cannot be given there" + where;
+  }
+  return "";
+}
+
 std::vector<std::string> session_arguments(const ManagerConfig& config, const StartRequest& request,
                                            const LaunchContext& context) {
   const std::string scenario = scenario_argument(config.scenarios, request.scenario);
@@ -45,12 +75,11 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
     for (const std::string& arg : config.session_args) args.push_back(expand(arg, values));
     return args;
   }
-  std::vector<std::string> args = {"--port",   "0",
-                                   "--bind",   "127.0.0.1",
-                                   "--rfb-only", "--ready-fd",
-                                   std::to_string(kReadyFd), "--scenario",
-                                   scenario,   "--seed",
-                                   std::to_string(context.seed)};
+  // The config's extra arguments first: sim_rfb takes the last of a repeated flag, so everything the
+  // manager and the link set below wins, whatever the config holds.
+  std::vector<std::string> args = config.session_args;
+  args.insert(args.end(), {"--port", "0", "--bind", "127.0.0.1", "--rfb-only", "--ready-fd", std::to_string(kReadyFd),
+                           "--scenario", scenario, "--seed", std::to_string(context.seed)});
   for (const auto& [name, value] : request.overrides) {
     const auto param = std::find_if(kOverrideParams.begin(), kOverrideParams.end(),
                                     [&name = name](const OverrideParam& p) { return name == p.name; });
@@ -64,7 +93,6 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
   args.insert(args.end(), {"--codec", config.codec});
   if (!request.code_success.empty()) args.insert(args.end(), {"--code-success", request.code_success});
   if (!request.code_timeout.empty()) args.insert(args.end(), {"--code-timeout", request.code_timeout});
-  args.insert(args.end(), config.session_args.begin(), config.session_args.end());
   return args;
 }
 

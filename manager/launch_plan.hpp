@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // The command line a session is started with, from the config and the participant's link. Pure: the
-// arguments are a list (never a shell string), and every value in them was validated before.
+// arguments are a list (never a shell string), and every value in them was validated before. The
+// manager's own flags cannot be overridden by the config's extra arguments.
 #pragma once
 
 #include <cstdint>
@@ -20,12 +21,23 @@ struct LaunchContext {
 };
 
 /// Arguments after the program name.
-///  - kSimRfb: --port 0 --bind 127.0.0.1 --rfb-only --ready-fd 3 --scenario S --seed N, one flag per
-///    override, --proxy-protocol --data-dir DIR --uid U --codec C (config.codec), --code-success T1 and
-///    --code-timeout T2 when the link has them, then config.session_args.
+///  - kSimRfb: config.session_args first, then the manager's own: --port 0 --bind 127.0.0.1 --rfb-only
+///    --ready-fd 3 --scenario S --seed N, one flag per override, --proxy-protocol --data-dir DIR --uid U
+///    --codec C (config.codec), --code-success T1 and --code-timeout T2 when the link has them. sim_rfb takes
+///    the last of a repeated flag, so the manager's and the link's win over the config's (which
+///    session_args_problem refuses for the manager's flags anyway).
 ///  - kRfb: config.session_args with {port}, {scenario}, {seed}, {uid}, {data_dir}, {t1} and {t2} replaced.
 std::vector<std::string> session_arguments(const ManagerConfig& config, const StartRequest& request,
                                            const LaunchContext& context);
+
+/// The sim_rfb flags config.session_args may not name: those the manager sets itself for every session, and
+/// --allow-origin (a session is reached only through the relay).
+extern const std::vector<std::string> kManagerFlags;
+
+/// Why config.session_args cannot be used with `kind` ("" when they can): for kSimRfb, an argument that
+/// is one of kManagerFlags, alone or as --flag=value, e.g. "session_args: --bind is set by sim_manager for
+/// every session and cannot be given there". An rfb program's template is its own and is not checked here.
+std::string session_args_problem(const std::vector<std::string>& session_args, SessionKind kind);
 
 /// The link's parameters (as validated: uid, scenario, seed, overrides) as a JSON object for the index.
 std::string parameters_json(const StartRequest& request, std::uint64_t seed);

@@ -5,6 +5,7 @@
 // relays, the session processes' readiness pipes, their timers and SIGCHLD. SQLite is written from the
 // same thread, so no state is shared between threads.
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <boost/asio/io_context.hpp>
@@ -111,6 +112,14 @@ int run(ManagerConfig config) {
     std::fprintf(stderr, "[manager] marked %d session(s) left by the previous run as interrupted\n", interrupted);
   }
   const auto frontend = manager::make_frontend(io, config, supervisor, metrics, web_root);
+  // Without signed links the uid is the only secret: anyone who learns or guesses one can start (or take
+  // over) that participant's session. Fine on loopback; on a public address it should be a choice.
+  if (config.link_secret.empty() && config.listen_address.rfind("127.", 0) != 0) {
+    std::fprintf(stderr,
+                 "[manager] warning: links are unsigned and the port listens on %s: anyone who knows a uid can start "
+                 "or take over its session; set link_secret (docs/security.md)\n",
+                 config.listen_address.c_str());
+  }
 
   // SIGINT / SIGTERM: stop taking connections, end every session, then leave.
   // The close frames sent to browsers get a moment to leave before the I/O loop stops.
@@ -145,6 +154,8 @@ int run(ManagerConfig config) {
 
 int main(int argc, char** argv) {
   namespace manager = rfbsim::manager;
+  // Everything the manager creates (the index, session folders, logs) is the study's data: private to its user.
+  ::umask(077);
   const std::vector<std::string> args(argv + 1, argv + argc);
   manager::ConfigOutcome parsed = manager::parse_manager_args(args, environment_variables());
   if (parsed.help) {

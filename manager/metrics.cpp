@@ -11,7 +11,9 @@ namespace {
 constexpr Rejection kAllRejections[] = {
     Rejection::kBusy,           Rejection::kBadRequest,   Rejection::kBadSignature,
     Rejection::kCompleted,      Rejection::kUnknownSession, Rejection::kEndedSession,
-    Rejection::kForbiddenOrigin, Rejection::kUnauthorized, Rejection::kStartFailed};
+    Rejection::kForbiddenOrigin, Rejection::kUnauthorized, Rejection::kStartFailed,
+    Rejection::kRateLimited,    Rejection::kConnectionLimit, Rejection::kUnspentLimit,
+    Rejection::kHead};
 
 std::string number(double value) {
   char text[32];
@@ -54,6 +56,10 @@ const char* rejection_name(Rejection reason) {
     case Rejection::kForbiddenOrigin: return "forbidden_origin";
     case Rejection::kUnauthorized: return "unauthorized";
     case Rejection::kStartFailed: return "start_failed";
+    case Rejection::kRateLimited: return "rate_limited";
+    case Rejection::kConnectionLimit: return "connection_limit";
+    case Rejection::kUnspentLimit: return "unspent_limit";
+    case Rejection::kHead: return "head_preview";
   }
   return "other";
 }
@@ -115,6 +121,18 @@ std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions
     out += std::string("rfbsim_rejections_total{reason=\"") + rejection_name(reason) + "\"} " +
            std::to_string(rejections(reason)) + "\n";
   }
+  header(out, "rfbsim_takeovers_total", "counter",
+         "Participant connections replaced by a newer browser of the same session (a refresh, a second tab).");
+  out += "rfbsim_takeovers_total " + std::to_string(takeovers_) + "\n";
+  header(out, "rfbsim_pong_timeouts_total", "counter", "WebSockets closed because their pong came too late.");
+  out += "rfbsim_pong_timeouts_total " + std::to_string(pong_timeouts_) + "\n";
+  header(out, "rfbsim_accept_errors_total", "counter",
+         "Failed accepts on the public port (EMFILE: out of descriptors), each followed by a short pause.");
+  out += "rfbsim_accept_errors_total " + std::to_string(accept_errors_) + "\n";
+  header(out, "rfbsim_connections", "gauge", "Connections open on the public port now.");
+  out += "rfbsim_connections " + std::to_string(connections_open_) + "\n";
+  header(out, "rfbsim_connection_addresses", "gauge", "Client addresses with a connection open now.");
+  out += "rfbsim_connection_addresses " + std::to_string(connection_addresses_) + "\n";
   // Each watched session's stream, as sim_rfb last reported it (about every second).
   const auto session_label = [](const SessionStream& s) { return "session=\"" + std::to_string(s.session_id) + "\""; };
   header(out, "rfbsim_session_rtt_ms", "gauge",

@@ -24,6 +24,10 @@ enum class Rejection {
   kForbiddenOrigin, ///< a WebSocket from an origin not allowed
   kUnauthorized,    ///< admin routes without the right token
   kStartFailed,     ///< the session program could not be started
+  kRateLimited,     ///< an address over its /start or WebSocket upgrade rate (429)
+  kConnectionLimit, ///< a connection over the per-address or total cap, closed at accept
+  kUnspentLimit,    ///< an address that started too many sessions nobody has seen yet (429)
+  kHead,            ///< a HEAD (link preview) of /start: answered, nothing started
 };
 
 const char* rejection_name(Rejection reason);
@@ -62,10 +66,22 @@ class Metrics {
   void add_bytes_to_client(std::uint64_t bytes) { bytes_to_client_ += bytes; }
   void add_bytes_to_session(std::uint64_t bytes) { bytes_to_session_ += bytes; }
   void count_relay_open(RelayKind kind) { ++relays_opened_[kind == RelayKind::kWatch ? 1 : 0]; }
+  /// A participant's second browser took the session over from the first.
+  void count_takeover() { ++takeovers_; }
+  /// A WebSocket closed because its pong did not come back in time.
+  void count_pong_timeout() { ++pong_timeouts_; }
+  /// accept() failed (e.g. EMFILE: no descriptor left) and accepting paused for a moment.
+  void count_accept_error() { ++accept_errors_; }
+  /// Gauges of the public port's connections, set by the frontend before rendering.
+  void set_connections(std::size_t open, std::size_t addresses) {
+    connections_open_ = open;
+    connection_addresses_ = addresses;
+  }
 
   [[nodiscard]] std::uint64_t starts() const { return starts_; }
   [[nodiscard]] std::uint64_t rejections(Rejection reason) const;
   [[nodiscard]] std::uint64_t bytes_to_client() const { return bytes_to_client_; }
+  [[nodiscard]] std::uint64_t takeovers() const { return takeovers_; }
 
   /// The exposition text. `sessions_by_state`: live sessions by state now, and ended ones by state over
   /// the whole index; `relays`: WebSocket relays open now; `streams`: live sessions' streams, for
@@ -82,6 +98,11 @@ class Metrics {
   std::uint64_t bytes_to_client_ = 0;
   std::uint64_t bytes_to_session_ = 0;
   std::array<std::uint64_t, 2> relays_opened_{};  // participant, watch
+  std::uint64_t takeovers_ = 0;
+  std::uint64_t pong_timeouts_ = 0;
+  std::uint64_t accept_errors_ = 0;
+  std::size_t connections_open_ = 0;
+  std::size_t connection_addresses_ = 0;
 };
 
 }  // namespace rfbsim::manager

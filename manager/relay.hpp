@@ -45,8 +45,15 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   static constexpr std::size_t kMaxPending = 1 << 20;
   static constexpr auto kDrainPoll = std::chrono::milliseconds(5);
 
+  /// Bytes from the session that must have reached the browser's socket before a participant relay reports its
+  /// first picture: more than the RFB handshake, the fence and the end-of-updates message (about 300 bytes from
+  /// sim_rfb), less than any first full picture (14 KiB at 320x240, tens of KiB at the sizes studies use).
+  static constexpr std::uint64_t kFirstPictureBytes = 1024;
+
   /// Called once when the session side closes or fails (not when close() was called first).
   using UpstreamLost = std::function<void(Relay&)>;
+  /// Called once, for participant relays, when kFirstPictureBytes have been written to the browser's socket.
+  using PictureDelivered = std::function<void(Relay&)>;
 
   /// `kind` kWatch drops the browser's input (RfbInputFilter) and closes it on bytes that cannot be framed.
   Relay(Server& server, websocketpp::connection_hdl browser, std::int64_t session_id, std::string token,
@@ -59,12 +66,16 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
         metrics_(metrics),
         on_upstream_lost_(std::move(on_upstream_lost)),
         upstream_(server.get_io_service()),
-        drain_timer_(server.get_io_service()) {}
+        drain_timer_(server.get_io_service()),
+        picture_timer_(server.get_io_service()) {}
 
   [[nodiscard]] std::int64_t session_id() const { return session_id_; }
   [[nodiscard]] const std::string& token() const { return token_; }
   [[nodiscard]] RelayKind kind() const { return kind_; }
   [[nodiscard]] bool connecting_or_connected() const { return connect_started_; }
+
+  /// What to call when the first picture has gone to the browser (participant relays only).
+  void on_picture_delivered(PictureDelivered callback) { on_picture_delivered_ = std::move(callback); }
 
   /// A PROXY protocol line naming the browser's address, sent to the session before any browser byte
   /// (sim_rfb records the participant's address, hashed, rather than ours). Call before connect().
@@ -120,6 +131,7 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     closed_ = true;
     boost::system::error_code ignored;
     drain_timer_.cancel();
+    picture_timer_.cancel();
     upstream_.close(ignored);
     websocketpp::lib::error_code ec;
     auto connection = server_.get_con_from_hdl(browser_, ec);
@@ -136,6 +148,7 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     closed_ = true;
     boost::system::error_code ignored;
     drain_timer_.cancel();
+    picture_timer_.cancel();
     upstream_.close(ignored);
   }
 
@@ -161,6 +174,7 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
       send_ec = connection->send(self->buffer_.data(), bytes, websocketpp::frame::opcode::binary);
       if (send_ec) return;  // the browser is going; its close handler cleans up
       self->metrics_.add_bytes_to_client(bytes);
+      self->bytes_to_browser_ += bytes;
       self->read_when_drained();
     });
   }
@@ -170,6 +184,7 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     websocketpp::lib::error_code ec;
     auto connection = server_.get_con_from_hdl(browser_, ec);
     if (ec || closed_) return;
+    report_picture_delivered(connection->get_buffered_amount());
     if (connection->get_buffered_amount() + kReadChunk <= kMaxBuffered) {
       read_upstream();
       return;
@@ -178,6 +193,25 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     drain_timer_.async_wait([self = this->shared_from_this()](const boost::system::error_code& wait_ec) {
       if (!wait_ec) self->read_when_drained();
     });
+  }
+
+  // Written to the browser's socket = relayed minus what websocketpp still buffers. A picture relayed but still
+  // buffered is looked at again shortly: a still scene may send nothing more that would bring us back here.
+  void report_picture_delivered(std::size_t still_buffered) {
+    if (picture_reported_ || kind_ != RelayKind::kParticipant || !on_picture_delivered_) return;
+    if (bytes_to_browser_ < kFirstPictureBytes) return;
+    if (bytes_to_browser_ < still_buffered || bytes_to_browser_ - still_buffered < kFirstPictureBytes) {
+      picture_timer_.expires_after(kDrainPoll * 4);
+      picture_timer_.async_wait([self = this->shared_from_this()](const boost::system::error_code& wait_ec) {
+        if (wait_ec || self->closed_) return;
+        websocketpp::lib::error_code ec;
+        auto connection = self->server_.get_con_from_hdl(self->browser_, ec);
+        if (!ec) self->report_picture_delivered(connection->get_buffered_amount());
+      });
+      return;
+    }
+    picture_reported_ = true;
+    on_picture_delivered_(*this);
   }
 
   void write_upstream() {
@@ -206,12 +240,16 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   RfbInputFilter filter_;  // used by watch relays only
   Metrics& metrics_;
   UpstreamLost on_upstream_lost_;
+  PictureDelivered on_picture_delivered_;
   boost::asio::ip::tcp::socket upstream_;
   boost::asio::steady_timer drain_timer_;
+  boost::asio::steady_timer picture_timer_;
   std::array<char, kReadChunk> buffer_{};
   std::deque<std::string> pending_;
   std::string proxy_line_;
   std::size_t pending_bytes_ = 0;
+  std::uint64_t bytes_to_browser_ = 0;  // relayed from the session (some may still wait in websocketpp)
+  bool picture_reported_ = false;
   bool connect_started_ = false;
   bool connected_ = false;
   bool writing_ = false;

@@ -19,6 +19,7 @@ const char* state_name(SessionState state) {
     case SessionState::kCrashed: return "crashed";
     case SessionState::kFailed: return "failed";
     case SessionState::kInterrupted: return "interrupted";
+    case SessionState::kAbandoned: return "abandoned";
   }
   return "unknown";
 }
@@ -51,7 +52,9 @@ bool begin_ending(Session& session, SessionState end_as, std::string detail) {
   return true;
 }
 
-SessionState state_after_exit(const Session& session, int wait_status) {
+namespace {
+
+SessionState exit_state(const Session& session, int wait_status) {
   switch (session.state) {
     case SessionState::kEnding: return session.end_as;
     case SessionState::kStarting: return SessionState::kFailed;
@@ -60,6 +63,15 @@ SessionState state_after_exit(const Session& session, int wait_status) {
                                                                       : SessionState::kCrashed;
     default: return session.state;  // already final: nothing changes
   }
+}
+
+}  // namespace
+
+SessionState state_after_exit(const Session& session, int wait_status) {
+  const SessionState state = exit_state(session, wait_status);
+  // Nobody saw it: a preview, a blocked WebSocket or a tab closed early must not use up the participant.
+  if (is_live(session.state) && counts_as_completed(state) && !session.spent_at) return SessionState::kAbandoned;
+  return state;
 }
 
 std::string describe_wait_status(int wait_status) {

@@ -5,7 +5,10 @@
 //      |                  |  \--other exit--> crashed
 //      |                  \--expiry / idle / admin / shutdown--> ending --exit--> expired | idle | ended | shutdown
 //      \--exit or start timeout--> failed
-// A session found live in the index by a manager that restarted is marked interrupted.
+// A session found live in the index by a manager that restarted is marked interrupted. A session that would
+// end as finished, expired, idle or ended without its link ever being spent (no picture ever reached a
+// participant's browser: a link preview, a blocked WebSocket, a tab closed early) ends as abandoned instead,
+// and its uid may start again.
 #pragma once
 
 #include <sys/types.h>
@@ -32,13 +35,14 @@ enum class SessionState {
   kCrashed,      ///< the program died on its own (signal or non-zero status) while running
   kFailed,       ///< never became ready (bad parameters, start timeout, cannot run)
   kInterrupted,  ///< the manager died while it ran; found and ended by the next manager
+  kAbandoned,    ///< ran its course without a picture ever reaching a participant: the link is not spent
 };
 
 /// Every state, for metrics that list them all.
 inline constexpr SessionState kAllStates[] = {
     SessionState::kStarting, SessionState::kRunning, SessionState::kEnding,  SessionState::kFinished,
     SessionState::kExpired,  SessionState::kIdle,    SessionState::kEnded,   SessionState::kShutdown,
-    SessionState::kCrashed,  SessionState::kFailed,  SessionState::kInterrupted};
+    SessionState::kCrashed,  SessionState::kFailed,  SessionState::kInterrupted, SessionState::kAbandoned};
 
 /// "starting", "running", ... as stored in the index and shown in metrics.
 const char* state_name(SessionState state);
@@ -48,8 +52,8 @@ std::optional<SessionState> state_from_name(std::string_view name);
 bool is_live(SessionState state);
 
 /// A session that ran its course (finished, expired, idle, ended): its uid may not start again unless
-/// repeats are allowed. Crashed, failed, interrupted and shutdown sessions were not the participant's
-/// doing, so the same link may start afresh.
+/// repeats are allowed. Crashed, failed, interrupted, shutdown and abandoned sessions were not the
+/// participant's doing (or never had them), so the same link may start afresh.
 bool counts_as_completed(SessionState state);
 
 using WallTime = std::chrono::system_clock::time_point;
@@ -77,6 +81,14 @@ struct Session {
   WallTime created{};           ///< /start accepted
   std::optional<WallTime> ready_at;  ///< the program reported ready
   std::optional<WallTime> ended_at;  ///< the process was gone
+  /// When the link was spent: the session's first picture was delivered to a participant's browser. Unset
+  /// until then; a session that ends unspent is abandoned.
+  std::optional<WallTime> spent_at;
+  /// Why the session's recorded data is incomplete, as the program reported it (a full disk...); "" = complete.
+  std::string data_incomplete;
+  /// The client address /start came from, for the per-address limit on unspent sessions. Kept in memory only:
+  /// participants' addresses are not part of the study's record.
+  std::string start_address;
   /// The participant's stream as sim_rfb last reported it while someone watched; unset before the first report,
   /// when nobody watches, and for sessions read from the index (it is not stored there).
   std::optional<StreamReport> stream;
@@ -89,7 +101,8 @@ SessionState coming_state(const Session& session);
 /// Returns false (and changes nothing) if it is not starting or running.
 bool begin_ending(Session& session, SessionState end_as, std::string detail);
 
-/// The state a live session takes when its process exits with `wait_status` (as from waitpid).
+/// The state a live session takes when its process exits with `wait_status` (as from waitpid): abandoned
+/// instead of a completed state when its link was never spent.
 SessionState state_after_exit(const Session& session, int wait_status);
 
 /// "exit 3" or "signal 9" for a wait status.

@@ -22,7 +22,7 @@ CREATE TABLE IF NOT EXISTS sessions (
   seed          TEXT NOT NULL,          -- decimal: seeds are unsigned 64-bit
   host_id       TEXT NOT NULL,
   state         TEXT NOT NULL,          -- starting running ending finished expired idle ended shutdown
-                                        -- crashed failed interrupted
+                                        -- crashed failed interrupted abandoned
   detail        TEXT NOT NULL DEFAULT '',
   exit_status   TEXT NOT NULL DEFAULT '',  -- "exit N" or "signal N" once the process is gone
   outcome       TEXT,                   -- the task's outcome as sim_rfb reported it: completed, timeout
@@ -34,7 +34,9 @@ CREATE TABLE IF NOT EXISTS sessions (
   data_path     TEXT NOT NULL DEFAULT '',
   created_at    TEXT NOT NULL,          -- ISO 8601 UTC
   ready_at      TEXT,
-  ended_at      TEXT
+  ended_at      TEXT,
+  spent_at      TEXT,                   -- the first picture reached a participant: the link is spent
+  data_incomplete TEXT                  -- why the session's data is incomplete (a full disk...); NULL: complete
 );
 CREATE INDEX IF NOT EXISTS sessions_by_uid ON sessions (uid, id);
 CREATE INDEX IF NOT EXISTS sessions_by_state ON sessions (state);
@@ -42,7 +44,7 @@ CREATE INDEX IF NOT EXISTS sessions_by_state ON sessions (state);
 
 constexpr const char* kColumns =
     "id, uid, token, scenario, params, seed, host_id, state, detail, exit_status, pid, process_start, port, "
-    "data_path, created_at, ready_at, ended_at, outcome, code_success, code_timeout";
+    "data_path, created_at, ready_at, ended_at, outcome, code_success, code_timeout, spent_at, data_incomplete";
 
 // One prepared statement, finalized on scope exit.
 class Statement {
@@ -109,6 +111,8 @@ Session read_row(Statement& row) {
   s.outcome = row.text(17);
   s.code_success = row.text(18);
   s.code_timeout = row.text(19);
+  if (!row.is_null(20)) s.spent_at = parse_iso_utc(row.text(20));
+  s.data_incomplete = row.text(21);
   return s;
 }
 
@@ -171,14 +175,25 @@ SessionIndex::SessionIndex(const std::string& path) : path_(path) {
 SessionIndex::~SessionIndex() { sqlite3_close(db_); }
 
 void SessionIndex::add_missing_columns() {
-  // An index made by an earlier version lacks the completion codes: add them, so that a study can keep
-  // its index across an upgrade.
+  // An index made by an earlier version lacks the later columns: add them, so that a study can keep its
+  // index across an upgrade.
   bool has_codes = false;
-  Statement columns(db_, "PRAGMA table_info(sessions)");
-  while (columns.step()) has_codes = has_codes || columns.text(1) == "code_success";
-  if (has_codes) return;
-  exec("ALTER TABLE sessions ADD COLUMN code_success TEXT NOT NULL DEFAULT ''");
-  exec("ALTER TABLE sessions ADD COLUMN code_timeout TEXT NOT NULL DEFAULT ''");
+  bool has_spent = false;
+  {
+    Statement columns(db_, "PRAGMA table_info(sessions)");
+    while (columns.step()) {
+      has_codes = has_codes || columns.text(1) == "code_success";
+      has_spent = has_spent || columns.text(1) == "spent_at";
+    }
+  }
+  if (!has_codes) {
+    exec("ALTER TABLE sessions ADD COLUMN code_success TEXT NOT NULL DEFAULT ''");
+    exec("ALTER TABLE sessions ADD COLUMN code_timeout TEXT NOT NULL DEFAULT ''");
+  }
+  if (!has_spent) {
+    exec("ALTER TABLE sessions ADD COLUMN spent_at TEXT");
+    exec("ALTER TABLE sessions ADD COLUMN data_incomplete TEXT");
+  }
 }
 
 void SessionIndex::exec(const char* sql) {
@@ -217,7 +232,8 @@ std::int64_t SessionIndex::insert(const Session& s) {
 void SessionIndex::update(const Session& s) {
   Statement update(db_,
                    "UPDATE sessions SET state = ?, detail = ?, exit_status = ?, pid = ?, process_start = ?, "
-                   "port = ?, data_path = ?, ready_at = ?, ended_at = ?, outcome = ? WHERE id = ?");
+                   "port = ?, data_path = ?, ready_at = ?, ended_at = ?, outcome = ?, spent_at = ?, "
+                   "data_incomplete = ? WHERE id = ?");
   update.bind(1, std::string(state_name(s.state)));
   update.bind(2, s.detail);
   update.bind(3, s.exit_status);
@@ -232,7 +248,13 @@ void SessionIndex::update(const Session& s) {
   } else {
     update.bind(10, s.outcome);
   }
-  update.bind(11, s.id);
+  update.bind(11, s.spent_at);
+  if (s.data_incomplete.empty()) {
+    update.bind_null(12);
+  } else {
+    update.bind(12, s.data_incomplete);
+  }
+  update.bind(13, s.id);
   update.step();
   if (sqlite3_changes(db_) != 1) {
     throw std::runtime_error("session index: no session " + std::to_string(s.id) + " to update");

@@ -7,10 +7,12 @@
 #include <linux/close_range.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <csignal>
@@ -21,7 +23,94 @@
 #include <stdexcept>
 #include <vector>
 
+extern char** environ;
+
 namespace rfbsim::manager {
+
+const std::vector<std::string_view> kSessionVariables = {
+    "PATH", "LANG", "LC_ALL", "TZ",
+    // The renderer: an admin who points the manager at a GPU or at Mesa's software renderer means its
+    // sessions too (sim_rfb draws with EGL; llvmpipe reads LP_NUM_THREADS).
+    "EGL_PLATFORM", "LIBGL_ALWAYS_SOFTWARE", "GALLIUM_DRIVER", "MESA_LOADER_DRIVER_OVERRIDE", "LP_NUM_THREADS",
+    "__EGL_VENDOR_LIBRARY_FILENAMES", "__EGL_VENDOR_LIBRARY_DIRS"};
+
+namespace {
+
+constexpr std::string_view kRfbsimPrefix = "RFBSIM_";
+constexpr const char* kFallbackPath = "/usr/local/bin:/usr/bin:/bin";
+
+bool starts_with(std::string_view text, std::string_view prefix) { return text.substr(0, prefix.size()) == prefix; }
+
+}  // namespace
+
+std::string session_variable_problem(std::string_view name) {
+  const auto letter = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; };
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  bool valid = !name.empty() && letter(name.front());
+  for (const char c : name) valid = valid && (letter(c) || digit(c));
+  if (!valid) return "'" + std::string(name) + "' is not an environment variable name";
+  // The deny rule beats every allow rule, the RFBSIM_ prefix included: the manager's own secrets (which
+  // config.cpp also reads from the environment) must never reach a participant's process.
+  const bool secret = name == "RFBSIM_ADMIN_TOKEN" || name == "RFBSIM_LINK_SECRET" ||
+                      (starts_with(name, kRfbsimPrefix) && (name.find("TOKEN") != std::string_view::npos ||
+                                                            name.find("SECRET") != std::string_view::npos ||
+                                                            name.find("PASSWORD") != std::string_view::npos));
+  if (secret) return std::string(name) + " is a secret of the manager's and never given to a session";
+  return "";
+}
+
+std::vector<std::string> session_environment(const std::vector<EnvVar>& inherited, const SpawnSpec& spec) {
+  // What the caller asks for is checked first: a refused name there is a mistake to report, not to drop.
+  for (const std::string& name : spec.pass_env) {
+    if (const std::string problem = session_variable_problem(name); !problem.empty()) {
+      throw std::invalid_argument("session environment: " + problem);
+    }
+  }
+  for (const auto& [name, value] : spec.env) {
+    if (const std::string problem = session_variable_problem(name); !problem.empty()) {
+      throw std::invalid_argument("session environment: " + problem);
+    }
+    if (value.find('\0') != std::string::npos) {
+      throw std::invalid_argument("session environment: the value of " + name + " holds a NUL byte");
+    }
+  }
+  const auto named_in = [](const auto& list, std::string_view name) {
+    return std::find(list.begin(), list.end(), name) != list.end();
+  };
+  const auto set_by_spec = [&](std::string_view name) {
+    return std::any_of(spec.env.begin(), spec.env.end(), [&](const EnvVar& var) { return var.first == name; });
+  };
+
+  // The manager's allow-listed variables, in its order, each once (the first, as getenv finds it).
+  std::vector<std::string> out;
+  std::vector<std::string_view> taken;
+  for (const auto& [name, value] : inherited) {
+    const bool allowed =
+        named_in(kSessionVariables, name) || named_in(spec.pass_env, name) || starts_with(name, kRfbsimPrefix);
+    if (!allowed || name == "HOME" || set_by_spec(name) || named_in(taken, name)) continue;
+    if (!session_variable_problem(name).empty()) continue;
+    taken.push_back(name);
+    out.push_back(name + "=" + value);
+  }
+  // Programs and the shells they start look for PATH; without the manager's, a usual one.
+  if (!named_in(taken, "PATH") && !set_by_spec("PATH")) out.push_back(std::string("PATH=") + kFallbackPath);
+  // HOME is the session's folder, not the manager's: dotfiles and caches a program writes stay with that
+  // session, and no session reads what an earlier participant's left in a shared home.
+  if (!set_by_spec("HOME") && !spec.working_dir.empty()) out.push_back("HOME=" + spec.working_dir);
+  for (const auto& [name, value] : spec.env) out.push_back(name + "=" + value);
+  return out;
+}
+
+std::vector<EnvVar> current_environment() {
+  std::vector<EnvVar> out;
+  for (char** entry = environ; entry != nullptr && *entry != nullptr; ++entry) {
+    const std::string_view text(*entry);
+    const std::size_t equals = text.find('=');
+    if (equals == std::string_view::npos) continue;  // not NAME=value: nothing a session could use
+    out.emplace_back(std::string(text.substr(0, equals)), std::string(text.substr(equals + 1)));
+  }
+  return out;
+}
 
 namespace {
 
@@ -39,8 +128,8 @@ struct OwnedFd {
 };
 
 // The child's part, async-signal-safe only. Reports a failure as an errno value on `error_fd` and exits.
-[[noreturn]] void run_child(const SpawnSpec& spec, char* const* argv, int log_fd, int ready_write, int error_fd,
-                            pid_t parent) {
+[[noreturn]] void run_child(const SpawnSpec& spec, char* const* argv, char* const* envp, int log_fd, int ready_write,
+                            int error_fd, pid_t parent) {
   const auto fail = [error_fd](int stage) {
     const int code[2] = {stage, errno};
     [[maybe_unused]] const auto ignored = ::write(error_fd, code, sizeof code);
@@ -69,6 +158,11 @@ struct OwnedFd {
   limit(RLIMIT_AS, spec.limits.address_space_bytes, spec.limits.address_space_bytes);
   limit(RLIMIT_NOFILE, spec.limits.open_files, spec.limits.open_files);
   limit(RLIMIT_CPU, spec.limits.cpu_seconds, spec.limits.cpu_seconds + 5);
+  // No core files, soft and hard: a crashed session's memory holds a participant's data.
+  const rlimit no_core{0, 0};
+  if (::setrlimit(RLIMIT_CORE, &no_core) != 0) fail(2);
+  // What the session creates (its recordings, its own logs) is the manager user's alone.
+  ::umask(077);
 
   // Descriptors: 0 = /dev/null, 1 and 2 = the log, 3 = the readiness pipe, nothing else.
   const int null_fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
@@ -90,7 +184,7 @@ struct OwnedFd {
   }
 
   if (::chdir(spec.working_dir.c_str()) != 0) fail(4);
-  ::execv(spec.program.c_str(), argv);
+  ::execve(spec.program.c_str(), argv, envp);
   fail(5);
   ::_exit(127);  // not reached: fail() exits
 }
@@ -115,8 +209,17 @@ int move_above(int fd, int floor) {
 }  // namespace
 
 SpawnedProcess spawn_session_process(const SpawnSpec& spec) {
-  OwnedFd log{::open(spec.log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0640)};
+  // The environment first: a refused variable is the caller's mistake, found before anything is opened.
+  std::vector<std::string> env_strings = session_environment(current_environment(), spec);
+
+  // The log may hold what a participant typed or an error quoting the session's data: owner only, also
+  // when an earlier run left it with wider permissions.
+  OwnedFd log{::open(spec.log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600)};
   if (log.fd < 0) throw std::runtime_error("cannot open the session log " + spec.log_file + ": " + std::strerror(errno));
+  struct stat log_stat {};
+  if (::fstat(log.fd, &log_stat) == 0 && S_ISREG(log_stat.st_mode) && (log_stat.st_mode & 077) != 0) {
+    ::fchmod(log.fd, 0600);
+  }
   log.fd = move_above(log.fd, 10);
 
   OwnedFd ready_read, ready_write;
@@ -141,13 +244,16 @@ SpawnedProcess spawn_session_process(const SpawnSpec& spec) {
   std::vector<char*> argv;
   for (std::string& s : strings) argv.push_back(s.data());
   argv.push_back(nullptr);
+  std::vector<char*> envp;
+  for (std::string& s : env_strings) envp.push_back(s.data());
+  envp.push_back(nullptr);
 
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   if (pid == 0) {
     // The error pipe must sit above every descriptor the child keeps; move_above(…, 10) made sure.
-    run_child(spec, argv.data(), log.fd, ready_write.fd, error_write.fd, parent);
+    run_child(spec, argv.data(), envp.data(), log.fd, ready_write.fd, error_write.fd, parent);
   }
   // Also here, so that the group exists before anyone signals it, whichever side runs first.
   ::setpgid(pid, pid);

@@ -148,7 +148,7 @@ int Supervisor::recover_interrupted() {
   return static_cast<int>(left.size());
 }
 
-StartOutcome Supervisor::start(const StartRequest& request) {
+StartOutcome Supervisor::start(const StartRequest& request, const std::string& address) {
   StartOutcome outcome;
   Session* live = table_.by_uid(request.uid);
   if (live != nullptr && live->state == SessionState::kEnding) {
@@ -178,6 +178,19 @@ StartOutcome Supervisor::start(const StartRequest& request) {
     case Admission::kStartNew:
       break;
   }
+  // Made-up uids from one address would each hold a slot until the idle timeout; a participant has one
+  // session at a time, so a few unseen ones from one address is already generous.
+  const int unspent_cap = config_.abuse.unspent_sessions_per_address;
+  if (unspent_cap > 0 && !address.empty()) {
+    int unspent = 0;
+    for (Session* other : table_.all()) {
+      unspent += other->start_address == address && !other->spent_at && other->state != SessionState::kEnding ? 1 : 0;
+    }
+    if (unspent >= unspent_cap) {
+      outcome.kind = StartOutcome::Kind::kTooManyUnspent;
+      return outcome;
+    }
+  }
 
   Session session;
   session.uid = request.uid;
@@ -188,6 +201,7 @@ StartOutcome Supervisor::start(const StartRequest& request) {
   session.code_success = request.code_success;
   session.code_timeout = request.code_timeout;
   session.host_id = config_.host_id;
+  session.start_address = address;
   session.created = std::chrono::system_clock::now();
   const auto started = SteadyClock::now();
   // The row first: whatever happens next, the index knows this session existed.
@@ -323,6 +337,20 @@ bool Supervisor::take_pipe_line(Session& session, const std::string& line) {
     session.outcome = line.substr(8);
     save(session);
     log_session(session, "task outcome: " + session.outcome);
+    return true;
+  }
+  // The program can no longer write the session's data (a full disk): recorded, and by the config's policy
+  // the participant carries on or the session ends.
+  if (line.rfind("data incomplete", 0) == 0 && session.data_incomplete.empty()) {
+    const std::size_t reason_at = line.find("reason=");
+    session.data_incomplete = reason_at == std::string::npos ? "unknown" : line.substr(reason_at + 7, 160);
+    if (session.data_incomplete.empty()) session.data_incomplete = "unknown";
+    save(session);
+    log_session(session, "its data is incomplete: " + session.data_incomplete);
+    if (config_.on_data_incomplete == DataFailurePolicy::kEnd) {
+      begin_end(session, SessionState::kEnded, "the session's data could not be written: " + session.data_incomplete);
+      return false;
+    }
     return true;
   }
   log_session(session, "ignored a line from the program: '" + line.substr(0, 64) + "'");
@@ -468,6 +496,14 @@ void Supervisor::client_disconnected(std::int64_t id) {
   if (rt.clients == 0 && is_live(session->state) && session->state != SessionState::kEnding) {
     arm_idle_timer(*session);
   }
+}
+
+void Supervisor::picture_delivered(std::int64_t id) {
+  Session* session = table_.by_id(id);
+  if (session == nullptr || session->spent_at || !is_live(session->state)) return;
+  session->spent_at = std::chrono::system_clock::now();
+  save(*session);
+  log_session(*session, "link spent: the first picture reached the participant's browser");
 }
 
 bool Supervisor::end_by_admin(std::int64_t id) {

@@ -34,7 +34,9 @@ class SessionListener {
 
 /// The outcome of a /start.
 struct StartOutcome {
-  enum class Kind { kJoined, kStarted, kBusy, kCompleted, kFailed } kind = Kind::kFailed;
+  /// kTooManyUnspent: the address already started abuse.unspent_sessions_per_address sessions that no
+  /// participant has seen yet.
+  enum class Kind { kJoined, kStarted, kBusy, kCompleted, kFailed, kTooManyUnspent } kind = Kind::kFailed;
   std::string token;    ///< kJoined, kStarted
   std::string message;  ///< kFailed: why, for the log and the page
 };
@@ -54,12 +56,16 @@ class Supervisor {
   /// run) and marks those sessions interrupted. Returns how many there were.
   int recover_interrupted();
 
-  /// Admits a valid link: back to the uid's live session, or a new one, or why not.
-  StartOutcome start(const StartRequest& request);
+  /// Admits a valid link from client `address`: back to the uid's live session, or a new one, or why not.
+  StartOutcome start(const StartRequest& request, const std::string& address = "");
 
   /// A browser connected to / disconnected from a session (the idle timer counts from the last one gone).
   void client_connected(std::int64_t id);
   void client_disconnected(std::int64_t id);
+
+  /// The session's first picture was delivered to a participant's browser: its link is spent from now on
+  /// (recorded once, in the index). A session that ends before this is abandoned, and its uid may start again.
+  void picture_delivered(std::int64_t id);
 
   /// Ends a live session on an administrator's word; false if it is not live.
   bool end_by_admin(std::int64_t id);

@@ -87,6 +87,14 @@ std::vector<std::string> with_small_sessions(std::vector<std::string> flags) {
   return flags;
 }
 
+std::vector<std::string> without_abuse_limits(std::vector<std::string> flags) {
+  for (const char* flag : {"--rate-start-per-minute", "--rate-upgrade-per-minute", "--max-unspent-sessions-per-address"}) {
+    flags.emplace_back(flag);
+    flags.emplace_back("0");
+  }
+  return flags;
+}
+
 ManagerUnderTest::ManagerUnderTest(const std::filesystem::path& data_dir, const std::vector<std::string>& flags,
                                    ManagerOptions options)
     : data_dir_(data_dir), options_(std::move(options)) {

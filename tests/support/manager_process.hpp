@@ -53,6 +53,9 @@ struct IndexRow {
 std::vector<std::string> small_session_args();
 /// `flags` followed by small_session_args().
 std::vector<std::string> with_small_sessions(std::vector<std::string> flags);
+/// `flags` followed by the flags that switch off the per-address abuse limits (rates on /start and upgrades,
+/// unspent sessions per address), for tests that send many requests from loopback on purpose.
+std::vector<std::string> without_abuse_limits(std::vector<std::string> flags);
 
 /// How a ManagerUnderTest runs, beyond its data folder and flags.
 struct ManagerOptions {

@@ -85,12 +85,13 @@ TEST_CASE("a session with no browser ends after the idle timeout, and not while 
   TempDir data;
   ManagerUnderTest manager(data.path(), with_small_sessions({"--idle-timeout-s", "1"}));
 
-  SECTION("nobody ever connects") {
+  SECTION("nobody ever connects: abandoned, and the link may start again") {
     const std::string token = token_from_redirect(manager.start("uid=idle-1"));
-    REQUIRE(manager.wait_for_state(token, "idle", 15s));
+    REQUIRE(manager.wait_for_state(token, "abandoned", 15s));
     const auto row = manager.row_for_token(token);
     REQUIRE(row);
     CHECK(row->detail == "no browser connected for 1 s");
+    CHECK(manager.start("uid=idle-1").status == 302);
   }
 
   SECTION("a connected browser keeps it alive; leaving starts the clock") {
@@ -150,7 +151,8 @@ TEST_CASE("an administrator ends a session through the API, and only with the to
 
 TEST_CASE("200 start/end cycles leave no process, descriptor or listening port behind", "[manager][cycles]") {
   TempDir data;
-  ManagerUnderTest manager(data.path(), with_small_sessions({"--admin-token", kAdminToken, "--max-sessions", "1"}));
+  ManagerUnderTest manager(data.path(), rfbsim::test::without_abuse_limits(
+                                            with_small_sessions({"--admin-token", kAdminToken, "--max-sessions", "1"})));
   constexpr int kCycles = 200;
   std::set<int> session_ports;
   std::vector<pid_t> session_pids;
@@ -164,7 +166,7 @@ TEST_CASE("200 start/end cycles leave no process, descriptor or listening port b
     session_ports.insert(row->port);
     session_pids.push_back(static_cast<pid_t>(row->pid));
     REQUIRE(manager.end_session(row->id, kAdminToken).status == 200);
-    REQUIRE(manager.wait_for_state(token, "ended"));
+    REQUIRE(manager.wait_for_state(token, "abandoned"));  // ended before any participant saw it
     if (cycle == 0) descriptors_after_first = manager.open_descriptors();
   }
   // The status poll that just returned may still hold its connection for a moment on the manager's side;
@@ -178,6 +180,6 @@ TEST_CASE("200 start/end cycles leave no process, descriptor or listening port b
   for (const int port : session_ports) CHECK(std::find(listening.begin(), listening.end(), port) == listening.end());
   const auto rows = manager.index_rows();
   CHECK(rows.size() == kCycles);
-  CHECK(std::all_of(rows.begin(), rows.end(), [](const auto& r) { return r.state == "ended"; }));
+  CHECK(std::all_of(rows.begin(), rows.end(), [](const auto& r) { return r.state == "abandoned"; }));
   CHECK(manager.metric("rfbsim_session_starts_total") == kCycles);
 }

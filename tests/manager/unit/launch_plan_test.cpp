@@ -66,14 +66,17 @@ TEST_CASE("sim_rfb gets the link's completion codes, each only when the link has
   CHECK(parameters_json(r, 7) == R"({"uid":"p01","scenario":"lab","seed":"7","t1":"OK-123","t2":"LATE_9"})");
 }
 
-TEST_CASE("sim_rfb gets one flag per override, then the configured extra arguments") {
+TEST_CASE("sim_rfb gets the configured extra arguments first, then one flag per override") {
   ManagerConfig config;
   config.scenarios = {"warehouse", "lab=/srv/scenarios/lab.yaml"};
   config.session_args = {"--width", "1280", "--fps=30"};
   StartRequest r = request("lab");
   r.overrides = {{"avatar_start", "1.5,-2,0.25"}, {"robot_goal", "dock"}, {"crowd", "12"}};
   const LaunchContext context{18446744073709551615ULL, 0, "/data/p01-1"};
-  CHECK(session_arguments(config, r, context) == Args{"--port",
+  CHECK(session_arguments(config, r, context) == Args{"--width",
+                                                       "1280",
+                                                       "--fps=30",
+                                                       "--port",
                                                        "0",
                                                        "--bind",
                                                        "127.0.0.1",
@@ -96,10 +99,70 @@ TEST_CASE("sim_rfb gets one flag per override, then the configured extra argumen
                                                        "--uid",
                                                        "p01",
                                                        "--codec",
-                                                       "auto",
-                                                       "--width",
-                                                       "1280",
-                                                       "--fps=30"});
+                                                       "auto"});
+}
+
+TEST_CASE("the manager's flags and the link's come after the config's, so that sim_rfb's last-wins parsing keeps "
+          "them") {
+  ManagerConfig config;
+  // A study-wide default the link may override, and a time limit the link has no say in.
+  config.session_args = {"--avatar-start", "door", "--time-limit", "90"};
+  StartRequest r = request("lab");
+  r.overrides = {{"avatar_start", "1,2,0"}};
+  const Args args = session_arguments(config, r, LaunchContext{7, 0, "/data/p01-1"});
+  const auto last_value = [&](const std::string& flag) {
+    const auto at = std::find(args.rbegin(), args.rend(), flag);
+    REQUIRE(at != args.rend());
+    REQUIRE(at != args.rbegin());
+    return *(at - 1);
+  };
+  CHECK(Args(args.begin(), args.begin() + 4) == Args{"--avatar-start", "door", "--time-limit", "90"});
+  CHECK(last_value("--avatar-start") == "1,2,0");
+  CHECK(last_value("--time-limit") == "90");
+  CHECK(last_value("--bind") == "127.0.0.1");
+  CHECK(last_value("--data-dir") == "/data/p01-1");
+}
+
+TEST_CASE("session_args may not name a flag the manager sets for sim_rfb") {
+  using rfbsim::manager::kManagerFlags;
+  using rfbsim::manager::session_args_problem;
+  CHECK(session_args_problem({}, SessionKind::kSimRfb).empty());
+  CHECK(session_args_problem({"--width", "1280", "--fps=30", "--time-limit", "90", "--debug-overlay"},
+                             SessionKind::kSimRfb)
+            .empty());
+  CHECK(session_args_problem({"--width", "640", "--bind", "0.0.0.0"}, SessionKind::kSimRfb) ==
+        "session_args: --bind is set by sim_manager for every session and cannot be given there");
+  CHECK(session_args_problem({"--port=5900"}, SessionKind::kSimRfb) ==
+        "session_args: --port is set by sim_manager for every session and cannot be given there");
+  CHECK(session_args_problem({"--data-dir=/tmp/x"}, SessionKind::kSimRfb) ==
+        "session_args: --data-dir is set by sim_manager for every session and cannot be given there");
+  CHECK(session_args_problem({"--codec", "jpeg"}, SessionKind::kSimRfb) ==
+        "session_args: --codec is set by sim_manager for every session and cannot be given there (use the codec "
+        "setting)");
+  CHECK(session_args_problem({"--seed", "3"}, SessionKind::kSimRfb) ==
+        "session_args: --seed is set by sim_manager for every session and cannot be given there (the link's seed "
+        "parameter sets it)");
+  CHECK(session_args_problem({"--allow-origin", "*"}, SessionKind::kSimRfb) ==
+        "session_args: --allow-origin cannot be given there: sessions are reached only through sim_manager's relay, "
+        "which checks the Origin itself (see frame_origins)");
+  // The first offender is named.
+  CHECK(session_args_problem({"--uid", "x", "--proxy-protocol"}, SessionKind::kSimRfb) ==
+        "session_args: --uid is set by sim_manager for every session and cannot be given there");
+  // Every flag of the list, alone and with a value attached, is refused.
+  for (const std::string& flag : kManagerFlags) {
+    INFO(flag);
+    CHECK_FALSE(session_args_problem({flag}, SessionKind::kSimRfb).empty());
+    CHECK_FALSE(session_args_problem({flag + "=1"}, SessionKind::kSimRfb).empty());
+  }
+  for (const std::string flag :
+       {"--bind", "--port", "--data-dir", "--ready-fd", "--rfb-only", "--proxy-protocol", "--uid", "--unix-socket",
+        "--web-root"}) {
+    CHECK(std::find(kManagerFlags.begin(), kManagerFlags.end(), flag) != kManagerFlags.end());
+  }
+  // Only the whole flag counts: longer names and values that merely contain one are fine.
+  CHECK(session_args_problem({"--bindings", "--portal", "x--port", "--web-rooted"}, SessionKind::kSimRfb).empty());
+  // An rfb program's template is its own: its --port is the program's flag, not sim_rfb's.
+  CHECK(session_args_problem({"--port", "{port}", "--bind=127.0.0.1"}, SessionKind::kRfb).empty());
 }
 
 TEST_CASE("an rfb program gets its argument template with the placeholders replaced") {

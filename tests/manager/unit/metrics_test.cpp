@@ -59,11 +59,16 @@ TEST_CASE("every series has its HELP and TYPE") {
                                                "# TYPE rfbsim_relay_connections gauge",
                                                "# TYPE rfbsim_relay_connections_total counter",
                                                "# TYPE rfbsim_rejections_total counter",
+                                               "# TYPE rfbsim_takeovers_total counter",
+                                               "# TYPE rfbsim_pong_timeouts_total counter",
+                                               "# TYPE rfbsim_accept_errors_total counter",
+                                               "# TYPE rfbsim_connections gauge",
+                                               "# TYPE rfbsim_connection_addresses gauge",
                                                "# TYPE rfbsim_session_rtt_ms gauge",
                                                "# TYPE rfbsim_session_fps gauge",
                                                "# TYPE rfbsim_session_codec_info gauge",
                                            });
-  CHECK(lines_starting(text, "# HELP ").size() == 11);
+  CHECK(lines_starting(text, "# HELP ").size() == 16);
 }
 
 TEST_CASE("sessions are listed for every state, zero included") {
@@ -82,6 +87,7 @@ TEST_CASE("sessions are listed for every state, zero included") {
                                                         "rfbsim_sessions{state=\"crashed\"} 1",
                                                         "rfbsim_sessions{state=\"failed\"} 0",
                                                         "rfbsim_sessions{state=\"interrupted\"} 0",
+                                                        "rfbsim_sessions{state=\"abandoned\"} 0",
                                                     });
 }
 
@@ -162,6 +168,10 @@ TEST_CASE("rejections are counted by reason and every reason is listed") {
             "rfbsim_rejections_total{reason=\"forbidden_origin\"} 0",
             "rfbsim_rejections_total{reason=\"unauthorized\"} 0",
             "rfbsim_rejections_total{reason=\"start_failed\"} 1",
+            "rfbsim_rejections_total{reason=\"rate_limited\"} 0",
+            "rfbsim_rejections_total{reason=\"connection_limit\"} 0",
+            "rfbsim_rejections_total{reason=\"unspent_limit\"} 0",
+            "rfbsim_rejections_total{reason=\"head_preview\"} 0",
         });
 }
 

@@ -7,6 +7,7 @@
 #include <poll.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -15,9 +16,11 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include "scratch_dir.hpp"
 #include "session_process.hpp"
@@ -376,5 +379,154 @@ TEST_CASE("a session dies with the process that started it") {
   const int status = reap(session);
   CHECK(WIFSIGNALED(status));
   CHECK(WTERMSIG(status) == SIGKILL);
+  CHECK(no_children_left());
+}
+
+namespace {
+
+using rfbsim::manager::EnvVar;
+using rfbsim::manager::session_environment;
+using rfbsim::manager::session_variable_problem;
+using Strings = std::vector<std::string>;
+
+// A spec for the pure environment tests: only the fields session_environment reads matter.
+SpawnSpec in_folder(const std::string& folder) {
+  SpawnSpec spec;
+  spec.working_dir = folder;
+  return spec;
+}
+
+// Sets a variable of this process for the scope, restoring the earlier value (or its absence) after.
+class ScopedVariable {
+ public:
+  ScopedVariable(const char* name, const char* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    ::setenv(name, value, 1);
+  }
+  ~ScopedVariable() {
+    if (old_) {
+      ::setenv(name_, old_->c_str(), 1);
+    } else {
+      ::unsetenv(name_);
+    }
+  }
+  ScopedVariable(const ScopedVariable&) = delete;
+  ScopedVariable& operator=(const ScopedVariable&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+}  // namespace
+
+TEST_CASE("a session's environment is the allow-listed part of the manager's, with HOME its folder") {
+  const std::vector<EnvVar> manager = {{"PATH", "/opt/bin:/usr/bin"}, {"HOME", "/home/rfbsim"},
+                                       {"FOO", "bar"},                {"LANG", "C.UTF-8"},
+                                       {"RFBSIM_ADDRESS_KEY", "k1"},  {"RFBSIM_ADMIN_TOKEN", "admin-secret-1234"},
+                                       {"RFBSIM_LINK_SECRET", "link-secret-1234"}, {"SSH_AUTH_SOCK", "/run/agent"},
+                                       {"TZ", "Europe/Paris"},        {"LIBGL_ALWAYS_SOFTWARE", "1"},
+                                       {"RFBSIM_SMTP_PASSWORD", "p"}, {"RFBSIM_HUD_FONT", "/f.ttf"},
+                                       {"LD_PRELOAD", "/x.so"},       {"DISPLAY", ":0"}};
+  CHECK(session_environment(manager, in_folder("/data/sessions/1-p1")) ==
+        Strings{"PATH=/opt/bin:/usr/bin", "LANG=C.UTF-8", "RFBSIM_ADDRESS_KEY=k1", "TZ=Europe/Paris",
+                "LIBGL_ALWAYS_SOFTWARE=1", "RFBSIM_HUD_FONT=/f.ttf", "HOME=/data/sessions/1-p1"});
+}
+
+TEST_CASE("a session without the manager's PATH gets a usual one") {
+  CHECK(session_environment({{"FOO", "bar"}}, in_folder("/d")) == Strings{"PATH=/usr/local/bin:/usr/bin:/bin", "HOME=/d"});
+  CHECK(session_environment({}, in_folder("")) == Strings{"PATH=/usr/local/bin:/usr/bin:/bin"});
+}
+
+TEST_CASE("the spec's variables are added and replace inherited ones; its extra names are passed on") {
+  SpawnSpec spec = in_folder("/d");
+  spec.env = {{"DISPLAY", ":1"}, {"XAUTHORITY", "/d/.Xauthority"}, {"PATH", "/bin"}, {"HOME", "/srv/x11"}};
+  spec.pass_env = {"LD_LIBRARY_PATH", "ABSENT"};
+  const std::vector<EnvVar> manager = {{"PATH", "/usr/bin"}, {"DISPLAY", ":0"}, {"LD_LIBRARY_PATH", "/opt/lib"},
+                                       {"FOO", "bar"}};
+  CHECK(session_environment(manager, spec) ==
+        Strings{"LD_LIBRARY_PATH=/opt/lib", "DISPLAY=:1", "XAUTHORITY=/d/.Xauthority", "PATH=/bin", "HOME=/srv/x11"});
+}
+
+TEST_CASE("a name given twice in the manager's environment reaches the session once") {
+  CHECK(session_environment({{"TZ", "UTC"}, {"TZ", "Europe/Paris"}}, in_folder("/d")) ==
+        Strings{"TZ=UTC", "PATH=/usr/local/bin:/usr/bin:/bin", "HOME=/d"});
+}
+
+TEST_CASE("the manager's secrets are refused by name, whoever asks for them") {
+  CHECK(session_variable_problem("RFBSIM_ADMIN_TOKEN") ==
+        "RFBSIM_ADMIN_TOKEN is a secret of the manager's and never given to a session");
+  CHECK_FALSE(session_variable_problem("RFBSIM_LINK_SECRET").empty());
+  CHECK_FALSE(session_variable_problem("RFBSIM_FUTURE_API_TOKEN").empty());
+  CHECK_FALSE(session_variable_problem("RFBSIM_DB_PASSWORD").empty());
+  CHECK(session_variable_problem("RFBSIM_ADDRESS_KEY").empty());
+  CHECK(session_variable_problem("DISPLAY").empty());
+  CHECK(session_variable_problem("_x9").empty());
+  CHECK(session_variable_problem("") == "'' is not an environment variable name");
+  CHECK(session_variable_problem("9LIVES") == "'9LIVES' is not an environment variable name");
+  CHECK(session_variable_problem("A=B") == "'A=B' is not an environment variable name");
+  CHECK(session_variable_problem("A B") == "'A B' is not an environment variable name");
+
+  // Asked for through the spec, a secret is an error, not a silent drop; the same for a bad name or value.
+  SpawnSpec spec = in_folder("/d");
+  spec.pass_env = {"RFBSIM_LINK_SECRET"};
+  CHECK_THROWS_WITH(session_environment({{"RFBSIM_LINK_SECRET", "s"}}, spec),
+                    "session environment: RFBSIM_LINK_SECRET is a secret of the manager's and never given to a "
+                    "session");
+  spec.pass_env.clear();
+  spec.env = {{"RFBSIM_ADMIN_TOKEN", "x"}};
+  CHECK_THROWS_AS(session_environment({}, spec), std::invalid_argument);
+  spec.env = {{"A=B", "x"}};
+  CHECK_THROWS_WITH(session_environment({}, spec), "session environment: 'A=B' is not an environment variable name");
+  spec.env = {{"DISPLAY", std::string(":0\0:1", 5)}};
+  CHECK_THROWS_WITH(session_environment({}, spec), "session environment: the value of DISPLAY holds a NUL byte");
+}
+
+TEST_CASE("a real session sees only its allow-listed environment, no core limit and umask 077") {
+  ScratchDir dir;
+  const ScopedVariable token("RFBSIM_ADMIN_TOKEN", "secret-admin-token-123");
+  const ScopedVariable link("RFBSIM_LINK_SECRET", "secret-link-key-456");
+  const ScopedVariable foo("FOO", "bar");
+  const ScopedVariable key("RFBSIM_ADDRESS_KEY", "study-key");
+  SpawnSpec spec = shell(dir, "");
+  spec.program = "/usr/bin/env";  // the environment as exec gave it, with no shell adding its own variables
+  spec.args = {};
+  spec.env = {{"DISPLAY", ":7"}};
+  CHECK(run_to_end(spec) == 0);
+  const std::string log = dir.read("session.log");
+  INFO(log);
+  CHECK(log.find("secret") == std::string::npos);
+  CHECK(log.find("FOO") == std::string::npos);
+  CHECK(log.find("\nRFBSIM_ADDRESS_KEY=study-key\n") != std::string::npos);
+  CHECK(log.find("\nDISPLAY=:7\n") != std::string::npos);
+  CHECK(log.find("\nHOME=" + dir.path().string() + "\n") != std::string::npos);
+  CHECK(("\n" + log).find("\nPATH=/") != std::string::npos);
+
+  // The limits and the mask, from the inside: the soft and hard core limits, the umask, a file it creates.
+  dir.write("session.log", "");
+  SpawnSpec probe = shell(dir, "ulimit -c; ulimit -H -c; umask; echo x > made; mkdir made.d; "
+                               "stat -c %a made made.d session.log");
+  CHECK(run_to_end(probe) == 0);
+  CHECK(dir.read("session.log") == "0\n0\n0077\n600\n700\n600\n");
+}
+
+TEST_CASE("the session log is created 0600, and an earlier one readable by others is narrowed") {
+  ScratchDir dir;
+  CHECK(run_to_end(shell(dir, "true")) == 0);
+  CHECK((std::filesystem::status(dir.path("session.log")).permissions() & std::filesystem::perms::all) ==
+        (std::filesystem::perms::owner_read | std::filesystem::perms::owner_write));
+  ::chmod(dir.path("session.log").c_str(), 0644);
+  CHECK(run_to_end(shell(dir, "echo again")) == 0);
+  CHECK((std::filesystem::status(dir.path("session.log")).permissions() & std::filesystem::perms::all) ==
+        (std::filesystem::perms::owner_read | std::filesystem::perms::owner_write));
+  CHECK(dir.read("session.log") == "again\n");
+}
+
+TEST_CASE("a refused variable in the spec starts nothing and opens no log") {
+  ScratchDir dir;
+  SpawnSpec spec = shell(dir, "true");
+  spec.env = {{"RFBSIM_LINK_SECRET", "x"}};
+  CHECK_THROWS_AS(spawn_session_process(spec), std::invalid_argument);
+  CHECK_FALSE(std::filesystem::exists(dir.path("session.log")));
   CHECK(no_children_left());
 }

@@ -21,6 +21,7 @@ using rfbsim::manager::kAllStates;
 using rfbsim::manager::Session;
 using rfbsim::manager::SessionState;
 using rfbsim::manager::state_after_exit;
+using rfbsim::manager::WallTime;
 using rfbsim::manager::state_from_name;
 using rfbsim::manager::state_name;
 
@@ -42,16 +43,18 @@ int killed_by(int signal) {
   return status;
 }
 
-Session in_state(SessionState state) {
+// A session in `state` whose participant has seen it (its link is spent), unless said otherwise.
+Session in_state(SessionState state, bool spent = true) {
   Session session;
   session.state = state;
+  if (spent) session.spent_at = WallTime{} + std::chrono::seconds(1);
   return session;
 }
 
 }  // namespace
 
 TEST_CASE("state names round-trip for every state") {
-  CHECK(std::size(kAllStates) == 11);
+  CHECK(std::size(kAllStates) == 12);
   for (const SessionState state : kAllStates) {
     INFO(state_name(state));
     CHECK(state_from_name(state_name(state)) == state);
@@ -97,6 +100,7 @@ TEST_CASE("finished, expired, idle and ended count as completed and nothing else
   CHECK_FALSE(counts_as_completed(SessionState::kFailed));
   CHECK_FALSE(counts_as_completed(SessionState::kInterrupted));
   CHECK_FALSE(counts_as_completed(SessionState::kShutdown));
+  CHECK_FALSE(counts_as_completed(SessionState::kAbandoned));
 }
 
 TEST_CASE("begin_ending moves a starting or running session to ending") {
@@ -146,6 +150,21 @@ TEST_CASE("the state after the process exits") {
     CHECK(state_after_exit(session, exited(0)) == SessionState::kIdle);
     CHECK(state_after_exit(session, exited(3)) == SessionState::kIdle);
     CHECK(state_after_exit(session, killed_by(SIGKILL)) == SessionState::kIdle);
+  }
+  SECTION("a session whose link was never spent is abandoned where it would have counted as completed") {
+    CHECK(state_after_exit(in_state(SessionState::kRunning, false), exited(0)) == SessionState::kAbandoned);
+    Session idle = in_state(SessionState::kRunning, false);
+    REQUIRE(begin_ending(idle, SessionState::kIdle, "idle"));
+    CHECK(state_after_exit(idle, exited(0)) == SessionState::kAbandoned);
+    Session expired = in_state(SessionState::kStarting, false);
+    REQUIRE(begin_ending(expired, SessionState::kExpired, "expired"));
+    CHECK(state_after_exit(expired, killed_by(SIGKILL)) == SessionState::kAbandoned);
+    // Crashes, failures and shutdowns keep their own state: they say what went wrong.
+    CHECK(state_after_exit(in_state(SessionState::kRunning, false), exited(1)) == SessionState::kCrashed);
+    CHECK(state_after_exit(in_state(SessionState::kStarting, false), exited(0)) == SessionState::kFailed);
+    Session shutdown = in_state(SessionState::kRunning, false);
+    REQUIRE(begin_ending(shutdown, SessionState::kShutdown, "stop"));
+    CHECK(state_after_exit(shutdown, exited(0)) == SessionState::kShutdown);
   }
   SECTION("already final: unchanged") {
     CHECK(state_after_exit(in_state(SessionState::kExpired), exited(1)) == SessionState::kExpired);
