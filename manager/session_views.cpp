@@ -63,4 +63,16 @@ std::string session_json(const Session& s, bool include_token) {
   return json + "}";
 }
 
+std::string session_record_json(const Session& s) {
+  const auto time = [](const std::optional<WallTime>& t) { return t ? "\"" + iso_utc(*t) + "\"" : std::string("null"); };
+  const auto text_or_null = [](const std::string& text) {
+    return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\"";
+  };
+  return "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"state\":\"" +
+         state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"created_at\":\"" + iso_utc(s.created) +
+         "\",\"ready_at\":" + time(s.ready_at) + ",\"spent_at\":" + time(s.spent_at) + ",\"ended_at\":" +
+         time(s.ended_at) + ",\"outcome\":" + text_or_null(s.outcome) +
+         ",\"data_incomplete\":" + text_or_null(s.data_incomplete) + "}\n";
+}
+
 }  // namespace rfbsim::manager

@@ -20,6 +20,7 @@
 
 #include "launch_plan.hpp"
 #include "session_process.hpp"
+#include "session_views.hpp"
 #include "tokens.hpp"
 
 namespace rfbsim::manager {
@@ -118,6 +119,26 @@ void Supervisor::save(const Session& session) {
   } catch (const std::exception& error) {
     log_session(session, std::string("cannot write the index: ") + error.what());
   }
+  write_record(session);
+}
+
+// manager.json beside the session's data: replaced whole (a temporary file renamed over it), so a reader never
+// sees half of one. Not synced: the index is the durable record, this is a convenience copy for the tools.
+void Supervisor::write_record(const Session& session) {
+  if (session.data_path.empty()) return;
+  const std::filesystem::path target = std::filesystem::path(session.data_path) / "manager.json";
+  const std::filesystem::path temporary = std::filesystem::path(session.data_path) / ".manager.json.tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << session_record_json(session);
+    if (!out.flush()) {
+      log_session(session, "cannot write " + target.string());
+      return;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, target, ec);
+  if (ec) log_session(session, "cannot write " + target.string() + ": " + ec.message());
 }
 
 int Supervisor::recover_interrupted() {

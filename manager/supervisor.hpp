@@ -97,6 +97,7 @@ class Supervisor {
   void process_gone(Session& session, int wait_status);
   void arm_idle_timer(Session& session);
   void save(const Session& session);
+  void write_record(const Session& session);
   std::string session_log_tail(const Session& session) const;
   Runtime& runtime(std::int64_t id);
 
