@@ -146,6 +146,11 @@ const std::map<std::string, Setting>& settings() {
          c.codec = v.front();
          return "";
        }}},
+      {"session_socket", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.front() != "unix" && v.front() != "tcp") return "expected unix or tcp";
+         c.session_socket = v.front();
+         return "";
+       }}},
       {"max_sessions", {false, integer(&ManagerConfig::max_sessions, 1, 10000)}},
       {"max_duration_s", {false, seconds(&ManagerConfig::max_duration, 1)}},
       {"idle_timeout_s", {false, seconds(&ManagerConfig::idle_timeout, 1)}},
@@ -290,6 +295,8 @@ std::string manager_usage() {
          "  --codec C               sim_rfb's picture encoding: auto (default: Tight JPEG, H.264 for a browser\n"
          "                          that offers it once its link needs it), jpeg, or h264 (H.264 for every\n"
          "                          browser that offers it; noVNC 1.6+ needs https or localhost for it)\n"
+         "  --session-socket unix|tcp   how the relay reaches a sim_rfb session: a private unix socket (default)\n"
+         "                          or a loopback TCP port\n"
          "  --max-sessions N        live sessions at once (default 4)\n"
          "  --max-duration-s S      a session ends S seconds after it started (default 300)\n"
          "  --idle-timeout-s S      a session ends after S seconds with no browser connected (default 60)\n"

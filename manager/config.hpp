@@ -67,6 +67,10 @@ struct ManagerConfig {
   /// kSimRfb: the picture encoding sim_rfb is started with (--codec): "auto" (Tight JPEG, H.264 for a browser
   /// that offers it once its link needs it), "jpeg" or "h264".
   std::string codec = "auto";
+  /// kSimRfb: how the relay reaches a session: "unix" (a socket of mode 0600 in a private folder: only the
+  /// manager's user can connect) or "tcp" (a loopback port, which any local user could open; for tools that
+  /// connect to sessions directly, such as bench_manager's direct path).
+  std::string session_socket = "unix";
   int max_sessions = 4;                      ///< live sessions at once; the next participant is told to wait
   std::chrono::seconds max_duration{300};    ///< a session is ended this long after it started (SEAN-EP: 5 min)
   std::chrono::seconds idle_timeout{60};     ///< ended after this long with no browser connected

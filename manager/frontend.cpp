@@ -311,7 +311,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
   // SessionListener
   void session_ready(const Session& session) override {
     for (auto& [hdl, relay] : relays_) {
-      if (relay->session_id() == session.id) relay->connect(session.port);
+      if (relay->session_id() == session.id) relay->connect(session.port, session.unix_socket);
     }
   }
 
@@ -667,7 +667,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
     if (kind == RelayKind::kParticipant) supervisor_.client_connected(session->id);
     // sim_rfb takes the browser's address from a PROXY line; a legacy program would take it for RFB bytes.
     if (config_.session_kind == SessionKind::kSimRfb) relay->set_proxy_line(proxy_line_for(*con));
-    if (session->state == SessionState::kRunning) relay->connect(session->port);
+    if (session->state == SessionState::kRunning) relay->connect(session->port, session->unix_socket);
   }
 
   void forget_websocket(connection_hdl hdl) {

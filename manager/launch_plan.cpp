@@ -78,8 +78,14 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
   // The config's extra arguments first: sim_rfb takes the last of a repeated flag, so everything the
   // manager and the link set below wins, whatever the config holds.
   std::vector<std::string> args = config.session_args;
-  args.insert(args.end(), {"--port", "0", "--bind", "127.0.0.1", "--rfb-only", "--ready-fd", std::to_string(kReadyFd),
-                           "--scenario", scenario, "--seed", std::to_string(context.seed)});
+  // A unix socket only the manager's user can open: another local user cannot reach a participant's session.
+  if (context.unix_socket.empty()) {
+    args.insert(args.end(), {"--port", "0", "--bind", "127.0.0.1"});
+  } else {
+    args.insert(args.end(), {"--unix-socket", context.unix_socket});
+  }
+  args.insert(args.end(), {"--rfb-only", "--ready-fd", std::to_string(kReadyFd), "--scenario", scenario, "--seed",
+                           std::to_string(context.seed)});
   for (const auto& [name, value] : request.overrides) {
     const auto param = std::find_if(kOverrideParams.begin(), kOverrideParams.end(),
                                     [&name = name](const OverrideParam& p) { return name == p.name; });

@@ -18,10 +18,14 @@ struct LaunchContext {
   std::uint64_t seed = 0;   ///< the link's seed or a drawn one
   int port = 0;             ///< kRfb: the port picked for the program; kSimRfb: 0 (it picks and reports)
   std::string data_dir;     ///< the session's folder
+  /// kSimRfb: the unix socket it serves on (mode 0600: only the manager's user can connect); "" = a loopback
+  /// TCP port it picks and reports.
+  std::string unix_socket;
 };
 
 /// Arguments after the program name.
-///  - kSimRfb: config.session_args first, then the manager's own: --port 0 --bind 127.0.0.1 --rfb-only
+///  - kSimRfb: config.session_args first, then the manager's own: --unix-socket PATH (or, without one,
+///    --port 0 --bind 127.0.0.1) --rfb-only
 ///    --ready-fd 3 --scenario S --seed N, one flag per override, --proxy-protocol --data-dir DIR --uid U
 ///    --codec C (config.codec), --code-success T1 and --code-timeout T2 when the link has them. sim_rfb takes
 ///    the last of a repeated flag, so the manager's and the link's win over the config's (which

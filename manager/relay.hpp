@@ -12,7 +12,9 @@
 #pragma once
 
 #include <array>
+#include <boost/asio/generic/stream_protocol.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/local/stream_protocol.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/write.hpp>
 #include <chrono>
@@ -45,14 +47,14 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   static constexpr std::size_t kMaxPending = 1 << 20;
   static constexpr auto kDrainPoll = std::chrono::milliseconds(5);
 
-  /// Bytes from the session that must have reached the browser's socket before a participant relay reports its
+  /// Bytes from the session that must have been relayed to the browser before a participant relay reports its
   /// first picture: more than the RFB handshake, the fence and the end-of-updates message (about 300 bytes from
   /// sim_rfb), less than any first full picture (14 KiB at 320x240, tens of KiB at the sizes studies use).
   static constexpr std::uint64_t kFirstPictureBytes = 1024;
 
   /// Called once when the session side closes or fails (not when close() was called first).
   using UpstreamLost = std::function<void(Relay&)>;
-  /// Called once, for participant relays, when kFirstPictureBytes have been written to the browser's socket.
+  /// Called once, for participant relays, when kFirstPictureBytes have been relayed to the browser.
   using PictureDelivered = std::function<void(Relay&)>;
 
   /// `kind` kWatch drops the browser's input (RfbInputFilter) and closes it on bytes that cannot be framed.
@@ -66,8 +68,7 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
         metrics_(metrics),
         on_upstream_lost_(std::move(on_upstream_lost)),
         upstream_(server.get_io_service()),
-        drain_timer_(server.get_io_service()),
-        picture_timer_(server.get_io_service()) {}
+        drain_timer_(server.get_io_service()) {}
 
   [[nodiscard]] std::int64_t session_id() const { return session_id_; }
   [[nodiscard]] const std::string& token() const { return token_; }
@@ -81,23 +82,27 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   /// (sim_rfb records the participant's address, hashed, rather than ours). Call before connect().
   void set_proxy_line(std::string line) { proxy_line_ = std::move(line); }
 
-  /// Connects to the session's port and starts relaying (browser bytes received so far go first).
-  void connect(int port) {
+  /// Connects to the session's loopback `port`, or to its `unix_socket` when that is not empty, and starts
+  /// relaying (browser bytes received so far go first).
+  void connect(int port, const std::string& unix_socket = "") {
     if (connect_started_ || closed_) return;
     connect_started_ = true;
     if (!proxy_line_.empty()) {
       pending_bytes_ += proxy_line_.size();
       pending_.push_front(proxy_line_);
     }
-    const boost::asio::ip::tcp::endpoint endpoint(boost::asio::ip::address_v4::loopback(),
-                                                  static_cast<unsigned short>(port));
+    const Endpoint endpoint =
+        unix_socket.empty()
+            ? Endpoint(boost::asio::ip::tcp::endpoint(boost::asio::ip::address_v4::loopback(),
+                                                      static_cast<unsigned short>(port)))
+            : Endpoint(boost::asio::local::stream_protocol::endpoint(unix_socket));
     upstream_.async_connect(endpoint, [self = this->shared_from_this()](const boost::system::error_code& ec) {
       if (self->closed_) return;
       if (ec) {
         self->lose_upstream();
         return;
       }
-      boost::system::error_code ignored;
+      boost::system::error_code ignored;  // no Nagle over TCP; a unix socket has none to switch off
       self->upstream_.set_option(boost::asio::ip::tcp::no_delay(true), ignored);
       self->connected_ = true;
       self->write_upstream();
@@ -131,7 +136,6 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     closed_ = true;
     boost::system::error_code ignored;
     drain_timer_.cancel();
-    picture_timer_.cancel();
     upstream_.close(ignored);
     websocketpp::lib::error_code ec;
     auto connection = server_.get_con_from_hdl(browser_, ec);
@@ -148,7 +152,6 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     closed_ = true;
     boost::system::error_code ignored;
     drain_timer_.cancel();
-    picture_timer_.cancel();
     upstream_.close(ignored);
   }
 
@@ -175,6 +178,7 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
       if (send_ec) return;  // the browser is going; its close handler cleans up
       self->metrics_.add_bytes_to_client(bytes);
       self->bytes_to_browser_ += bytes;
+      self->report_picture_delivered();
       self->read_when_drained();
     });
   }
@@ -184,7 +188,6 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     websocketpp::lib::error_code ec;
     auto connection = server_.get_con_from_hdl(browser_, ec);
     if (ec || closed_) return;
-    report_picture_delivered(connection->get_buffered_amount());
     if (connection->get_buffered_amount() + kReadChunk <= kMaxBuffered) {
       read_upstream();
       return;
@@ -195,21 +198,12 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
     });
   }
 
-  // Written to the browser's socket = relayed minus what websocketpp still buffers. A picture relayed but still
-  // buffered is looked at again shortly: a still scene may send nothing more that would bring us back here.
-  void report_picture_delivered(std::size_t still_buffered) {
+  // Relayed into the browser's WebSocket. At the start of a connection nothing else waits there (the flow
+  // control above keeps it under kMaxBuffered in any case), so the picture is on its way to the browser's
+  // socket at once; waiting for websocketpp to write it would race with an ending that closes the relay.
+  void report_picture_delivered() {
     if (picture_reported_ || kind_ != RelayKind::kParticipant || !on_picture_delivered_) return;
     if (bytes_to_browser_ < kFirstPictureBytes) return;
-    if (bytes_to_browser_ < still_buffered || bytes_to_browser_ - still_buffered < kFirstPictureBytes) {
-      picture_timer_.expires_after(kDrainPoll * 4);
-      picture_timer_.async_wait([self = this->shared_from_this()](const boost::system::error_code& wait_ec) {
-        if (wait_ec || self->closed_) return;
-        websocketpp::lib::error_code ec;
-        auto connection = self->server_.get_con_from_hdl(self->browser_, ec);
-        if (!ec) self->report_picture_delivered(connection->get_buffered_amount());
-      });
-      return;
-    }
     picture_reported_ = true;
     on_picture_delivered_(*this);
   }
@@ -241,14 +235,14 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   Metrics& metrics_;
   UpstreamLost on_upstream_lost_;
   PictureDelivered on_picture_delivered_;
-  boost::asio::ip::tcp::socket upstream_;
+  using Endpoint = boost::asio::generic::stream_protocol::endpoint;
+  boost::asio::generic::stream_protocol::socket upstream_;  // TCP or unix, whichever the session serves on
   boost::asio::steady_timer drain_timer_;
-  boost::asio::steady_timer picture_timer_;
   std::array<char, kReadChunk> buffer_{};
   std::deque<std::string> pending_;
   std::string proxy_line_;
   std::size_t pending_bytes_ = 0;
-  std::uint64_t bytes_to_browser_ = 0;  // relayed from the session (some may still wait in websocketpp)
+  std::uint64_t bytes_to_browser_ = 0;  // relayed from the session to the browser's WebSocket
   bool picture_reported_ = false;
   bool connect_started_ = false;
   bool connected_ = false;

@@ -73,7 +73,8 @@ struct Session {
   std::string exit_status;      ///< "exit 0", "signal 9", "" while running
   pid_t pid = -1;               ///< also the process group id (the session leads its own group)
   std::int64_t process_start = 0;  ///< the process's start time in clock ticks (/proc), to recognise it later
-  int port = 0;                 ///< loopback port the session serves RFB on, once known
+  int port = 0;                 ///< loopback port the session serves RFB on, once known (0 with a unix socket)
+  std::string unix_socket;      ///< or the unix socket it serves RFB on (sim_rfb sessions); memory only
   std::string data_path;        ///< the session's folder
   std::string code_success;     ///< the link's t1 (shown and sent to the survey on success); may be empty
   std::string code_timeout;     ///< the link's t2 (on timeout); may be empty

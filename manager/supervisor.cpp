@@ -14,6 +14,8 @@
 #include <boost/asio/steady_timer.hpp>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -63,6 +65,21 @@ int pick_free_port() {
   return port;
 }
 
+// A private folder for the sessions' unix sockets: mode 0700 from mkdtemp, so that only the manager's user can
+// even reach the sockets (which sim_rfb also makes 0600). Short, under the temporary directory, because a
+// socket path must fit in 108 bytes; "" (TCP ports instead) when that cannot be had.
+std::string make_socket_dir() {
+  std::error_code ec;
+  std::string pattern = (std::filesystem::temp_directory_path(ec) / "rfbsim-manager-XXXXXX").string();
+  if (ec || pattern.size() > 80) pattern = "/tmp/rfbsim-manager-XXXXXX";
+  if (::mkdtemp(pattern.data()) == nullptr) {
+    std::fprintf(stderr, "[manager] cannot make a folder for session sockets (%s); sessions use loopback ports\n",
+                 std::strerror(errno));
+    return "";
+  }
+  return pattern;
+}
+
 void log_session(const Session& session, const std::string& text) {
   std::fprintf(stderr, "[manager] session %lld (uid %s): %s\n", static_cast<long long>(session.id),
                session.uid.c_str(), text.c_str());
@@ -98,10 +115,15 @@ Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::s
       metrics_(metrics),
       table_(config.max_sessions),
       child_watch_(std::make_unique<ChildWatch>(io)) {
+  if (config_.session_kind == SessionKind::kSimRfb && config_.session_socket == "unix") socket_dir_ = make_socket_dir();
   wait_for_children();
 }
 
-Supervisor::~Supervisor() = default;
+Supervisor::~Supervisor() {
+  if (socket_dir_.empty()) return;
+  std::error_code ignored;
+  std::filesystem::remove_all(socket_dir_, ignored);
+}
 
 void Supervisor::wait_for_children() {
   child_watch_->signals.async_wait([this](const boost::system::error_code& ec, int) {
@@ -246,6 +268,9 @@ StartOutcome Supervisor::start(const StartRequest& request, const std::string& a
       context.port = pick_free_port();
       if (context.port == 0) throw std::runtime_error("no free loopback port");
       session.port = context.port;
+    } else if (!socket_dir_.empty()) {
+      context.unix_socket = socket_dir_ + "/" + std::to_string(session.id) + ".sock";
+      session.unix_socket = context.unix_socket;
     }
     SpawnSpec spec;
     spec.program = program_;
@@ -332,6 +357,15 @@ void Supervisor::watch_ready_pipe(Session& session) {
 
 bool Supervisor::take_pipe_line(Session& session, const std::string& line) {
   if (session.state == SessionState::kStarting) {
+    // On a unix socket: "ready unix PATH", and only the path it was given.
+    if (!session.unix_socket.empty()) {
+      if (line != "ready unix " + session.unix_socket) {
+        begin_end(session, SessionState::kFailed, "the program's ready line is not 'ready unix " + session.unix_socket + "'");
+        return false;
+      }
+      mark_ready(session, 0);
+      return true;
+    }
     int port = 0;
     char rest = 0;
     if (std::sscanf(line.c_str(), "ready %d%c", &port, &rest) != 1 || port < 1 || port > 65535) {
@@ -411,8 +445,8 @@ void Supervisor::mark_ready(Session& session, int port) {
   const double seconds = std::chrono::duration<double>(SteadyClock::now() - rt.started).count();
   metrics_.observe_startup(seconds);
   char text[96];
-  std::snprintf(text, sizeof text, "ready on port %d after %.3f s", port, seconds);
-  log_session(session, text);
+  std::snprintf(text, sizeof text, "ready after %.3f s on ", seconds);
+  log_session(session, text + (session.unix_socket.empty() ? "port " + std::to_string(port) : session.unix_socket));
   if (listener_ != nullptr) listener_->session_ready(session);
 }
 
@@ -476,6 +510,11 @@ void Supervisor::process_gone(Session& session, int wait_status) {
   }
   session.state = final_state;
   session.ended_at = std::chrono::system_clock::now();
+  // A killed sim_rfb leaves its socket file behind.
+  if (!session.unix_socket.empty()) {
+    std::error_code ignored;
+    std::filesystem::remove(session.unix_socket, ignored);
+  }
   save(session);
   log_session(session, std::string(state_name(final_state)) + " (" + session.exit_status + ")");
   if (listener_ != nullptr) listener_->session_closing(session);

@@ -113,6 +113,7 @@ class Supervisor {
   std::unique_ptr<ChildWatch> child_watch_;
   std::function<void()> on_all_gone_;  // set by shutdown()
   bool shutting_down_ = false;
+  std::string socket_dir_;  // private folder (0700) of the sessions' unix sockets; "" = they use TCP ports
 };
 
 }  // namespace rfbsim::manager

@@ -157,7 +157,7 @@ std::vector<IndexRow> ManagerUnderTest::query_index(const std::optional<std::str
   sqlite3_stmt* stmt = nullptr;
   const std::string sql =
       std::string("SELECT id, uid, token, scenario, params, seed, host_id, state, detail, exit_status, data_path, "
-                  "pid, port, created_at, ready_at, ended_at FROM sessions") +
+                  "pid, port, created_at, ready_at, ended_at, spent_at, data_incomplete FROM sessions") +
       (token ? " WHERE token = ?" : "") + " ORDER BY id";
   if (sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt, nullptr) != SQLITE_OK) {
     const std::string message = sqlite3_errmsg(db);
@@ -188,6 +188,8 @@ std::vector<IndexRow> ManagerUnderTest::query_index(const std::optional<std::str
     row.port = sqlite3_column_int(stmt, 12);
     row.created_at = text(13);
     row.ready_at = text(14);
+    row.spent_at = text(16);
+    row.data_incomplete = text(17);
     row.ended_at = text(15);
     rows.push_back(row);
   }

@@ -47,6 +47,9 @@ struct IndexRow {
   int port = 0;
   /// ISO 8601 UTC with milliseconds, e.g. "2025-01-31T12:00:00.123Z"; ready_at and ended_at are "" while unset.
   std::string created_at, ready_at, ended_at;
+  /// When the first picture reached a participant ("" while the link is unspent), and why the data is
+  /// incomplete ("" when it is complete).
+  std::string spent_at, data_incomplete;
 };
 
 /// Small, cheap sessions for tests: the lab at 320x240, 15 frames per second.

@@ -119,6 +119,13 @@ TEST_CASE("an administrator ends a session through the API, and only with the to
   WsRfbBridge bridge(manager.ws_url(token));
   RfbTestClient client("127.0.0.1", bridge.port());
   REQUIRE(client.wait_for_updates(1, 20s));
+  // The participant saw a picture (the link is spent), so the researcher's end counts as ended, not abandoned.
+  REQUIRE(client.pump_until(
+      [&] {
+        const auto spent = manager.row_for_token(token);
+        return spent && !spent->spent_at.empty();
+      },
+      20s));
 
   const std::string path = "/api/sessions/" + std::to_string(row->id) + "/end";
   const auto post = [&](const std::string& headers) {

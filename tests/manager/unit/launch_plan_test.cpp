@@ -33,6 +33,14 @@ TEST_CASE("sim_rfb gets its fixed flags, the scenario, the seed and where to rec
              "--proxy-protocol", "--data-dir", "/data/p01-1", "--uid", "p01", "--codec", "auto"});
 }
 
+TEST_CASE("with a unix socket sim_rfb is told the socket instead of a port and an address") {
+  ManagerConfig config;
+  const LaunchContext context{7, 0, "/data/p01-1", "/tmp/rfbsim-manager-x/1.sock"};
+  CHECK(session_arguments(config, request("lab"), context) ==
+        Args{"--unix-socket", "/tmp/rfbsim-manager-x/1.sock", "--rfb-only", "--ready-fd", "3", "--scenario", "lab",
+             "--seed", "7", "--proxy-protocol", "--data-dir", "/data/p01-1", "--uid", "p01", "--codec", "auto"});
+}
+
 TEST_CASE("sim_rfb gets the configured codec, and only sim_rfb does") {
   ManagerConfig config;
   config.codec = "h264";
