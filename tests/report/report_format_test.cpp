@@ -140,5 +140,6 @@ TEST_CASE("docs/report.md defines every column of sessions.csv and summary.csv")
     INFO(r.name);
     CHECK(docs.find("`pct_" + r.name + "`") != std::string::npos);
   }
-  CHECK(summary_csv_header().size() == 3 + summary_rates().size() + 3 * summarized_columns().size());
+  CHECK(docs.find("`excluded_sessions`") != std::string::npos);
+  CHECK(summary_csv_header().size() == 4 + summary_rates().size() + 3 * summarized_columns().size());
 }

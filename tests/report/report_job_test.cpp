@@ -116,7 +116,7 @@ TEST_CASE("the overall and per-scenario tables give the rates and statistics of 
 
   // report.md and report.html carry the same groups.
   const std::string md = read_text(out / "report.md");
-  CHECK_THAT(md, Catch::Contains("| scenario lab | 3 | 33.3 |"));
+  CHECK_THAT(md, Catch::Contains("| scenario lab | 3 | 0 | 33.3 |"));
   const std::string html = read_text(out / "report.html");
   CHECK_THAT(html, Catch::Contains("<td>scenario warehouse</td>"));
   CHECK_THAT(html, Catch::Contains("<svg"));

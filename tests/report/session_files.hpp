@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Test helpers: a scratch folder per test, session folders written as docs/data.md describes from
-// hand-made tracks (a position and velocity per agent as functions of time), and a small CSV parser.
+// hand-made tracks (a position and velocity per agent as functions of time), sim_manager's manager.json,
+// and a small CSV parser.
 #pragma once
 
 #include <stdlib.h>
@@ -67,6 +68,8 @@ struct SessionSpec {
   std::vector<nlohmann::json> events;  ///< each with tick, time, type and its keys
   std::optional<std::string> outcome;
   std::optional<std::uint64_t> end_tick;
+  std::optional<std::string> data_incomplete;  ///< session.json's data_incomplete.reason, when the recording failed
+  std::uint64_t dropped_bytes = 0;             ///< and its dropped_bytes
 };
 
 /// An event line's object: tick, time (tick / 60) and type first, then `fields`.
@@ -80,7 +83,7 @@ inline nlohmann::json event(std::uint64_t tick, const std::string& type, const n
 inline nlohmann::json session_json(const SessionSpec& spec) {
   nlohmann::json agents = nlohmann::json::array();
   for (const Track& t : spec.tracks) agents.push_back({{"kind", t.kind}, {"id", t.id}, {"radius", t.radius}});
-  return {{"format", "rfbsim-session/1"},
+  nlohmann::json doc = {{"format", "rfbsim-session/1"},
           {"uid", spec.uid},
           {"scenario", spec.scenario},
           {"scenario_file", spec.scenario_file},
@@ -102,6 +105,34 @@ inline nlohmann::json session_json(const SessionSpec& spec) {
           {"outcome", spec.outcome ? nlohmann::json(*spec.outcome) : nlohmann::json(nullptr)},
           {"completion", nullptr},
           {"tasks_done", nlohmann::json::array()}};
+  if (spec.data_incomplete) {
+    doc["data_incomplete"] = {{"reason", *spec.data_incomplete}, {"dropped_bytes", spec.dropped_bytes}};
+  }
+  return doc;
+}
+
+/// manager.json as sim_manager writes it beside a session's data: created at 2026-11-25T10:00:00.000Z,
+/// spent `spent_after_ms` later (null when none), with `data_incomplete` (null when none).
+inline std::string manager_json(const std::string& uid, const std::string& state,
+                                std::optional<int> spent_after_ms = std::nullopt,
+                                std::optional<std::string> data_incomplete = std::nullopt) {
+  const auto at = [](int ms) {
+    char text[40];
+    std::snprintf(text, sizeof text, "2026-11-25T10:%02d:%02d.%03dZ", ms / 60000, ms / 1000 % 60, ms % 1000);
+    return nlohmann::json(text);
+  };
+  const nlohmann::json doc = {
+      {"id", 3},
+      {"uid", uid},
+      {"state", state},
+      {"detail", state == "abandoned" ? "no browser connected for 60 s" : ""},
+      {"created_at", at(0)},
+      {"ready_at", at(300)},
+      {"spent_at", spent_after_ms ? at(*spent_after_ms) : nlohmann::json(nullptr)},
+      {"ended_at", at(59000)},
+      {"outcome", nullptr},
+      {"data_incomplete", data_incomplete ? nlohmann::json(*data_incomplete) : nlohmann::json(nullptr)}};
+  return doc.dump() + "\n";
 }
 
 /// trajectories.csv for `spec`, six decimals as the writer prints them.

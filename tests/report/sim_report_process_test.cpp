@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // The real sim_report binary on a generated data folder: its exit status, the files it writes, sessions.csv
-// parsing to the right rows, and the usage errors.
+// parsing to the right rows, manager.json's warnings and left-out sessions on stderr, and the usage errors.
 #include <catch2/catch.hpp>
 
 #include <sys/wait.h>
@@ -62,6 +62,26 @@ TEST_CASE("sim_report exits 1 and names a skipped session, writing the report of
   CHECK_THAT(read_text(scratch.path() / "stderr.txt"),
              Catch::Contains("skipped 2-bad: ") && Catch::Contains("events.jsonl: missing"));
   CHECK(csv_records(read_text(scratch.path() / "out" / "sessions.csv")).size() == 1);
+}
+
+TEST_CASE("sim_report warns of a broken manager.json and says how many sessions had no participant") {
+  ScratchDir scratch;
+  const auto data = scratch.path() / "data";
+  write_session(data / "1-seen", small_session());
+  write_text(data / "1-seen" / "manager.json", manager_json("p001", "finished", 900));
+  write_session(data / "2-unseen", small_session());
+  write_text(data / "2-unseen" / "manager.json", manager_json("p001", "abandoned"));
+  write_session(data / "3-broken", small_session());
+  write_text(data / "3-broken" / "manager.json", "{\"uid\": \"p001\", \"state\": \"lost\"}");
+
+  CHECK(sim_report(scratch, quoted(data)) == 0);
+  const std::string err = read_text(scratch.path() / "stderr.txt");
+  CHECK_THAT(err, Catch::Contains("sim_report: warning: " + (data / "3-broken" / "manager.json").string() +
+                                  ": key 'state': unknown state 'lost'; reported without it\n"));
+  CHECK_THAT(err, Catch::Contains("3 sessions reported, 0 skipped\n"));
+  CHECK_THAT(err, Catch::Contains("sim_report: 1 of them without a participant (link never spent), left out of the "
+                                  "statistics\n"));
+  CHECK(csv_records(read_text(data / "report" / "summary.csv"))[0].at("sessions") == "2");
 }
 
 TEST_CASE("sim_report exits 2 on usage errors and 0 for help") {

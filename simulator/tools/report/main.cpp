@@ -37,12 +37,17 @@ int run(const rfbsim::report::CliOptions& options) {
   for (const SkippedSession& s : result.skipped) {
     std::fprintf(stderr, "sim_report: skipped %s: %s\n", s.folder.c_str(), s.reason.c_str());
   }
+  for (const std::string& w : result.warnings) std::fprintf(stderr, "sim_report: warning: %s\n", w.c_str());
   for (const std::string& e : result.write_errors) std::fprintf(stderr, "sim_report: %s\n", e.c_str());
   if (result.sessions_found == 0) {
     std::fprintf(stderr, "sim_report: no session folders (with a session.json) under %s\n", options.data_dir.c_str());
   }
   std::fprintf(stderr, "sim_report: %zu sessions reported, %zu skipped\n", result.sessions_reported,
                result.skipped.size());
+  if (result.sessions_excluded > 0) {
+    std::fprintf(stderr, "sim_report: %zu of them without a participant (link never spent), left out of the "
+                 "statistics\n", result.sessions_excluded);
+  }
   for (const std::filesystem::path& file : result.written) std::printf("%s\n", file.c_str());
   return result.exit_status();
 }

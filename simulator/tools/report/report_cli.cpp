@@ -54,6 +54,8 @@ std::string usage_text() {
          "  -h, --help  this text\n"
          "\n"
          "A session that cannot be read is skipped and named on stderr with the reason; the others are reported.\n"
+         "Where sim_manager left a manager.json beside a session, its state and whether its link was spent are\n"
+         "reported, and a session nobody saw (abandoned) is left out of the statistics and counted.\n"
          "Exit status: 0 all reported, 1 data errors (sessions skipped, none found, or output not written),\n"
          "2 usage errors.\n";
 }

@@ -6,6 +6,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "participation.hpp"
 #include "text_format.hpp"
 
 namespace rfbsim::report {
@@ -53,6 +54,16 @@ std::vector<Column> make_columns() {
       column("end_reason", "", "why it stopped; empty if it did not end cleanly",
              [](const M& m) { return Value(m.end_reason); }),
       column("ended_cleanly", "", "session.json has ended_at", [](const M& m) { return Value(m.ended_cleanly); }),
+      column("manager_state", "", "sim_manager's state for it (manager.json); empty without one",
+             [](const M& m) { return Value(m.manager_state); }, false, true),
+      column("manager_detail", "", "sim_manager's words on that state",
+             [](const M& m) { return Value(m.manager_detail); }),
+      column("link_spent", "", "its first picture reached the participant's browser; empty without manager.json",
+             [](const M& m) { return m.has_manager_record ? Value(m.link_spent) : Value(); }, false, true),
+      column("link_spent_after", "s", "from the manager creating the session to that first picture",
+             [](const M& m) { return maybe(m.link_spent_after); }, false, true),
+      column("in_statistics", "", "counted in summary.csv; no when nobody took part (link never spent)",
+             [](const M& m) { return Value(exclusion_reason(m).empty()); }),
       column("duration", "s", "end_tick / tick_hz, else the last sample's time",
              [](const M& m) { return Value(m.duration); }, true, true),
       column("measured_from", "s", "start of what is measured: the task clock's start (first picture)",
@@ -63,6 +74,12 @@ std::vector<Column> make_columns() {
       column("partial_samples", "", "sample ticks left out: an agent's row missing or repeated",
              [](const M& m) { return count(m.partial_samples); }),
       column("torn_lines", "", "unfinished last lines dropped", [](const M& m) { return count(m.torn_lines); }),
+      column("data_complete", "", "the recording is whole (no data_incomplete)",
+             [](const M& m) { return Value(m.data_incomplete.empty()); }, false, true),
+      column("data_incomplete", "", "why the recording stopped early (a full disk...); empty when whole",
+             [](const M& m) { return Value(m.data_incomplete); }),
+      column("dropped_bytes", "", "bytes of data dropped after that failure",
+             [](const M& m) { return Value(static_cast<std::int64_t>(m.dropped_bytes)); }),
       column("timed_out", "", "outcome is timeout", [](const M& m) { return Value(m.timed_out); }),
       column("completed", "", "outcome is completed", [](const M& m) { return Value(m.completed); }),
       column("avatar_path_length", "m", "distance the avatar walked",

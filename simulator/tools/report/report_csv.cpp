@@ -35,7 +35,7 @@ std::string sessions_csv(const std::vector<SessionMetrics>& sessions) {
 }
 
 std::vector<std::string> summary_csv_header() {
-  std::vector<std::string> names = {"scope", "scenario", "sessions"};
+  std::vector<std::string> names = {"scope", "scenario", "sessions", "excluded_sessions"};
   for (const Rate& rate : summary_rates()) names.push_back("pct_" + rate.name);
   for (const std::string& column : summarized_columns()) {
     names.push_back(column + "_n");
@@ -49,7 +49,8 @@ std::string summary_csv(const std::vector<GroupSummary>& groups) {
   std::string out;
   append_line(out, summary_csv_header());
   for (const GroupSummary& g : groups) {
-    std::vector<std::string> cells = {g.all ? "all" : "scenario", csv_field(g.scenario), std::to_string(g.sessions)};
+    std::vector<std::string> cells = {g.all ? "all" : "scenario", csv_field(g.scenario), std::to_string(g.sessions),
+                                      std::to_string(g.excluded)};
     for (const double pct : g.rate_percent) cells.push_back(format_number(pct, 6));
     for (const Statistic& s : g.statistics) {
       cells.push_back(std::to_string(s.n));

@@ -13,7 +13,7 @@ namespace rfbsim::report {
 /// A header line of session_columns()' names, then one line per session.
 std::string sessions_csv(const std::vector<SessionMetrics>& sessions);
 
-/// summary.csv's column names: scope, scenario, sessions, pct_<rate> per rate, then <column>_n,
+/// summary.csv's column names: scope, scenario, sessions, excluded_sessions, pct_<rate> per rate, then <column>_n,
 /// <column>_mean and <column>_median per summarized column.
 std::vector<std::string> summary_csv_header();
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "group_summary.hpp"
+#include "participation.hpp"
 #include "session_metrics.hpp"
 
 namespace rfbsim::report {
@@ -27,7 +28,9 @@ struct ReportData {
   std::string data_dir;                 ///< as given on the command line
   std::vector<SessionMetrics> sessions; ///< in folder order
   std::vector<GroupSummary> groups;     ///< summarize(sessions)
+  std::vector<Exclusion> exclusions;    ///< exclusions(sessions): left out of groups, with why
   std::vector<SkippedSession> skipped;
+  std::vector<std::string> warnings;    ///< reported all the same, e.g. a broken manager.json (names the file)
   std::vector<SessionPlot> plots;            ///< parallel to sessions; may be empty (no plots)
   std::vector<std::string> map_definitions;  ///< MapDrawing::definition of every map the plots use
 };

@@ -4,6 +4,7 @@
 
 #include <map>
 
+#include "participation.hpp"
 #include "report_columns.hpp"
 #include "text_format.hpp"
 #include "zone_histogram.hpp"
@@ -56,11 +57,11 @@ std::string optional_cell(const std::optional<double>& v) { return v ? format_fi
 
 void overview(std::string& out, const ReportData& data) {
   out += "<h2>Overview (% of sessions)</h2>\n";
-  Row header = {"group", "N"};
+  Row header = {"group", "N", "left out"};
   for (const Rate& r : summary_rates()) header.push_back("% " + html_escape(r.meaning));
   std::vector<Row> rows;
   for (const GroupSummary& g : data.groups) {
-    Row row = {group_name(g), std::to_string(g.sessions)};
+    Row row = {group_name(g), std::to_string(g.sessions), std::to_string(g.excluded)};
     for (const double pct : g.rate_percent) row.push_back(format_fixed(pct, 1));
     rows.push_back(row);
   }
@@ -83,7 +84,9 @@ void overview(std::string& out, const ReportData& data) {
 void histograms(std::string& out, const ReportData& data) {
   out += "<h2>Time in Hall's zones (the robot's closest person, the avatar included)</h2>\n";
   std::map<std::string, std::vector<const SessionMetrics*>> by_scenario;
-  for (const SessionMetrics& m : data.sessions) by_scenario[m.scenario].push_back(&m);
+  for (const SessionMetrics& m : data.sessions) {
+    if (exclusion_reason(m).empty()) by_scenario[m.scenario].push_back(&m);  // the participants' sessions only
+  }
   for (const auto& [scenario, sessions] : by_scenario) {
     out += "<figure>" + zone_histogram_svg(zone_bins(sessions)) + "<figcaption>Scenario " +
            html_escape(scenario.empty() ? "(unnamed)" : scenario) + ": " + std::to_string(sessions.size()) +
@@ -128,6 +131,30 @@ void plots(std::string& out, const ReportData& data) {
   }
 }
 
+// The sessions left out of the statistics (counted per reason), the skipped ones and the warnings.
+void left_out(std::string& out, const ReportData& data) {
+  if (!data.exclusions.empty()) {
+    out += "<h2>Left out of the statistics</h2>\n<p>Sessions nobody took part in: sim_manager's manager.json says "
+           "no picture ever reached a participant's browser (the link was never spent). They are in the session "
+           "table (link_spent no) and in sessions.csv (in_statistics 0), not in the overview, the measures or the "
+           "histograms.</p>\n";
+    std::vector<Row> rows;
+    for (const Exclusion& e : data.exclusions) rows.push_back({html_escape(e.reason), std::to_string(e.sessions)});
+    table(out, {"why", "sessions"}, rows);
+  }
+  if (!data.skipped.empty()) {
+    out += "<h2>Skipped sessions</h2>\n";
+    std::vector<Row> rows;
+    for (const SkippedSession& s : data.skipped) rows.push_back({html_escape(s.folder), html_escape(s.reason)});
+    table(out, {"folder", "reason"}, rows);
+  }
+  if (!data.warnings.empty()) {
+    out += "<h2>Warnings</h2>\n<ul>\n";
+    for (const std::string& w : data.warnings) out += "<li>" + html_escape(w) + "</li>\n";
+    out += "</ul>\n";
+  }
+}
+
 }  // namespace
 
 std::string html_report(const ReportData& data) {
@@ -139,17 +166,14 @@ std::string html_report(const ReportData& data) {
     out += "</defs></svg>\n";
   }
   out += "<h1>rfbsim session report</h1>\n<p>Data folder: " + html_escape(data.data_dir) + "<br>" +
-         std::to_string(data.sessions.size()) + " sessions reported, " + std::to_string(data.skipped.size()) +
+         std::to_string(data.sessions.size()) + " sessions reported (" + std::to_string(data.groups.front().sessions) +
+         " in the statistics, " + std::to_string(data.groups.front().excluded) +
+         " without a participant left out), " + std::to_string(data.skipped.size()) +
          " skipped. Definitions of every measure: docs/report.md.</p>\n";
   overview(out, data);
   histograms(out, data);
   session_table(out, data);
-  if (!data.skipped.empty()) {
-    out += "<h2>Skipped sessions</h2>\n";
-    std::vector<Row> rows;
-    for (const SkippedSession& s : data.skipped) rows.push_back({html_escape(s.folder), html_escape(s.reason)});
-    table(out, {"folder", "reason"}, rows);
-  }
+  left_out(out, data);
   plots(out, data);
   out += "</body></html>\n";
   return out;

@@ -8,6 +8,8 @@
 #include <optional>
 
 #include "record/digest.hpp"
+#include "manager_record.hpp"
+#include "participation.hpp"
 #include "record/session_log.hpp"
 #include "report_csv.hpp"
 #include "report_html.hpp"
@@ -76,6 +78,26 @@ std::string folder_name(const std::filesystem::path& dir, const std::filesystem:
   return relative.empty() ? dir.string() : relative.string();
 }
 
+// manager.json into `metrics`, when the folder has one. A broken one, or one of another participant (a folder
+// pieced together by hand), is a warning: the session is then reported as if run without the manager.
+void add_record(const std::filesystem::path& dir, const sim::SessionLog& log, SessionMetrics& metrics,
+                std::vector<std::string>& warnings) {
+  try {
+    const std::optional<ManagerRecord> record = read_manager_record(dir);
+    if (!record) return;
+    if (record->uid != log.meta.uid) {
+      warnings.push_back((dir / "manager.json").string() + ": uid '" + record->uid + "' is not session.json's '" +
+                         log.meta.uid + "'; ignored");
+      return;
+    }
+    add_manager_record(*record, metrics);
+  } catch (const ManagerRecordError& e) {
+    warnings.push_back(std::string(e.what()) + "; reported without it");
+  } catch (const std::exception& e) {
+    warnings.push_back((dir / "manager.json").string() + ": " + e.what() + "; reported without it");
+  }
+}
+
 // Writes a whole file through a temporary and a rename, so that a reader never sees half a report.
 void write_file(const std::filesystem::path& path, const std::string& text, JobResult& result) {
   const std::filesystem::path temporary = path.string() + ".tmp";
@@ -120,6 +142,7 @@ JobResult run_report(const std::filesystem::path& data_dir, const std::filesyste
       const SampledSession samples = assemble_samples(log);
       SessionMetrics metrics = session_metrics(log, samples);
       metrics.folder = folder;
+      add_record(dirs[i], log, metrics, data.warnings);
       const LoadedMap& map = maps.get(log.meta.scenario_file);
       SessionPlot plot{trajectory_svg(samples, map.drawing ? &*map.drawing : nullptr), caption(log, samples, map)};
       data.sessions.push_back(std::move(metrics));
@@ -133,7 +156,10 @@ JobResult run_report(const std::filesystem::path& data_dir, const std::filesyste
   }
   result.sessions_reported = data.sessions.size();
   result.skipped = data.skipped;
+  result.warnings = data.warnings;
   data.groups = summarize(data.sessions);
+  data.exclusions = exclusions(data.sessions);
+  result.sessions_excluded = data.groups.front().excluded;
   data.map_definitions = maps.take_definitions();
 
   std::error_code ec;

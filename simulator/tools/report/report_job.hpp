@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // The report job: every session folder under a data folder read, measured and plotted, and the four
 // report files written. A session that cannot be read is skipped with its reason; it never stops the rest.
+// sim_manager's manager.json, where a folder has one, adds how the session ended and whether anyone saw it.
 #pragma once
 
 #include <cstddef>
@@ -17,7 +18,9 @@ namespace rfbsim::report {
 struct JobResult {
   std::size_t sessions_found = 0;       ///< folders with a session.json
   std::size_t sessions_reported = 0;
+  std::size_t sessions_excluded = 0;    ///< reported but left out of the statistics (no participant)
   std::vector<SkippedSession> skipped;  ///< in folder order
+  std::vector<std::string> warnings;    ///< ReportData::warnings; they do not change the exit status
   std::vector<std::string> write_errors;  ///< output files that could not be written, with why
   std::vector<std::filesystem::path> written;  ///< output files written
 

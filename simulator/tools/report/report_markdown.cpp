@@ -40,16 +40,17 @@ std::string with_unit(const Column& c) { return c.unit.empty() ? c.name : c.name
 std::string markdown_report(const ReportData& data) {
   std::string out = "# rfbsim session report\n\n";
   out += "Data folder: " + markdown_escape(data.data_dir) + "  \n";
-  out += std::to_string(data.sessions.size()) + " sessions reported, " + std::to_string(data.skipped.size()) +
-         " skipped. Definitions of every measure: docs/report.md.\n\n";
+  out += std::to_string(data.sessions.size()) + " sessions reported (" + std::to_string(data.groups.front().sessions) +
+         " in the statistics, " + std::to_string(data.groups.front().excluded) + " without a participant left out), " +
+         std::to_string(data.skipped.size()) + " skipped. Definitions of every measure: docs/report.md.\n\n";
 
   // The SEAN-EP rates per group.
   out += "## Overview (% of sessions)\n\n";
-  Row header = {"group", "N"};
+  Row header = {"group", "N", "left out"};
   for (const Rate& r : summary_rates()) header.push_back("% " + r.meaning);
   std::vector<Row> rows;
   for (const GroupSummary& g : data.groups) {
-    Row row = {group_name(g), std::to_string(g.sessions)};
+    Row row = {group_name(g), std::to_string(g.sessions), std::to_string(g.excluded)};
     for (const double pct : g.rate_percent) row.push_back(format_fixed(pct, 1));
     rows.push_back(row);
   }
@@ -88,11 +89,27 @@ std::string markdown_report(const ReportData& data) {
   table(out, header, rows);
   out += "Every column, unrounded: sessions.csv.\n\n";
 
+  if (!data.exclusions.empty()) {
+    out += "## Left out of the statistics\n\n";
+    out += "Sessions nobody took part in: sim_manager's manager.json says no picture ever reached a participant's "
+           "browser (the link was never spent). They are in the session table (link\\_spent no) and in sessions.csv "
+           "(in\\_statistics 0), not in the overview or the measures.\n\n";
+    rows.clear();
+    for (const Exclusion& e : data.exclusions) rows.push_back({markdown_escape(e.reason), std::to_string(e.sessions)});
+    table(out, {"why", "sessions"}, rows);
+  }
+
   if (!data.skipped.empty()) {
     out += "## Skipped sessions\n\n";
     rows.clear();
     for (const SkippedSession& s : data.skipped) rows.push_back({markdown_escape(s.folder), markdown_escape(s.reason)});
     table(out, {"folder", "reason"}, rows);
+  }
+
+  if (!data.warnings.empty()) {
+    out += "## Warnings\n\n";
+    for (const std::string& w : data.warnings) out += "- " + markdown_escape(w) + "\n";
+    out += "\n";
   }
   return out;
 }

@@ -104,6 +104,9 @@ SessionMetrics session_metrics(const sim::SessionLog& log, const SampledSession&
   out.samples = measured.samples.size();
   out.partial_samples = samples.partial_samples;
   out.torn_lines = log.torn_lines;
+  // A failure with no words for it is still a failure.
+  if (meta.data_incomplete) out.data_incomplete = meta.data_incomplete->empty() ? "unknown" : *meta.data_incomplete;
+  out.dropped_bytes = meta.dropped_bytes;
 
   out.timed_out = out.outcome == "timeout";
   out.completed = out.outcome == "completed";

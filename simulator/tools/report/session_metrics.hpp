@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -36,6 +37,17 @@ struct SessionMetrics {
   std::size_t samples = 0;          ///< whole trajectory samples used
   std::size_t partial_samples = 0;  ///< sample ticks left out (someone's row missing or repeated)
   std::size_t torn_lines = 0;       ///< unfinished last lines dropped
+
+  // Whether the recording is whole: session.json's data_incomplete, else the reason manager.json gives.
+  std::string data_incomplete;      ///< why the files end early (a full disk...); "" when they are whole
+  std::uint64_t dropped_bytes = 0;  ///< bytes sim_rfb dropped after the failure (session.json's count)
+
+  // What sim_manager's manager.json says (add_manager_record); all empty without one (a session run by hand).
+  bool has_manager_record = false;
+  std::string manager_state;   ///< the manager's state: finished, expired, ..., abandoned
+  std::string manager_detail;  ///< the manager's words on it
+  bool link_spent = false;     ///< the session's first picture reached the participant's browser
+  std::optional<double> link_spent_after;  ///< s from the manager creating the session to that picture
 
   // The SEAN-EP study's measures.
   bool timed_out = false;    ///< outcome is timeout
