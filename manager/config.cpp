@@ -180,6 +180,7 @@ const std::map<std::string, Setting>& settings() {
       {"admin_token", {false, text(&ManagerConfig::admin_token, 16)}},
       {"link_secret", {false, text(&ManagerConfig::link_secret, 16)}},
       {"allow_repeat", {false, boolean(&ManagerConfig::allow_repeat)}},
+      {"require_link_expiry", {false, boolean(&ManagerConfig::require_link_expiry)}},
       {"host_id", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          if (!is_identifier(v.front())) return "expected letters, digits, - and _ (at most 64)";
          c.host_id = v.front();
@@ -308,6 +309,7 @@ std::string manager_usage() {
          "  --admin-token T         enables /admin and /api/sessions (or RFBSIM_ADMIN_TOKEN; 16+ chars)\n"
          "  --link-secret S         /start links must be signed (or RFBSIM_LINK_SECRET; 16+ chars)\n"
          "  --allow-repeat B        a uid whose session ended may start another (default false)\n"
+         "  --require-link-expiry B signed links must carry exp=UNIX_SECONDS, and expire then (default false)\n"
          "  --host-id ID            this host's name in the index (default: the host name)\n"
          "  --web-root DIR          the participant page (default: the built or installed one)\n"
          "  --public-url ORIGIN     this host's public origin; /start redirects there (several hosts)\n"
@@ -462,6 +464,9 @@ std::string validate_config(const ManagerConfig& config) {
     bool has_port = false;
     for (const std::string& arg : config.session_args) has_port = has_port || arg.find("{port}") != std::string::npos;
     if (!has_port) return "session_kind rfb needs {port} in session_args, where the program is told its port";
+  }
+  if (config.require_link_expiry && config.link_secret.empty()) {
+    return "require_link_expiry needs link_secret: an unsigned exp could simply be edited";
   }
   // The manager's own flags (where the session listens, its data folder...) are not the config's to change.
   if (std::string problem = session_args_problem(config.session_args, config.session_kind); !problem.empty()) {

@@ -81,6 +81,7 @@ struct ManagerConfig {
   std::vector<std::string> frame_origins;    ///< origins allowed to frame the page and open its WebSocket
   std::string admin_token;                   ///< empty = /admin and /api are off
   std::string link_secret;                   ///< non-empty = /start links must carry a valid sig
+  bool require_link_expiry = false;          ///< with a link secret: links must carry exp (a Unix time, seconds)
   bool allow_repeat = false;                 ///< a uid whose session ended may start another
   std::string host_id;                       ///< recorded in the index; empty = this machine's host name
   std::string web_root;                      ///< participant page; empty = the built or installed one

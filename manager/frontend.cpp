@@ -441,6 +441,20 @@ class FrontendImpl final : public Frontend, public SessionListener {
       refuse(con, 400, Rejection::kBadRequest, "This link is not valid", parsed.error);
       return;
     }
+    // A link published in the open can be given an end: exp, a Unix time, signed with the rest.
+    if (config_.require_link_expiry && !parsed.request->expires_at) {
+      refuse(con, 403, Rejection::kBadSignature, "This link is not valid",
+             "The link has no expiry time. Please use the exact link your survey gave you.");
+      return;
+    }
+    const auto unix_now = std::chrono::duration_cast<std::chrono::seconds>(
+                              std::chrono::system_clock::now().time_since_epoch())
+                              .count();
+    if (parsed.request->expires_at && *parsed.request->expires_at < static_cast<std::uint64_t>(unix_now)) {
+      refuse(con, 410, Rejection::kBadSignature, "This link has expired",
+             "The study link is no longer valid. Please go back to the survey or contact the researcher.");
+      return;
+    }
     const StartOutcome outcome = supervisor_.start(*parsed.request, address);
     switch (outcome.kind) {
       case StartOutcome::Kind::kJoined:

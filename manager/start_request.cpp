@@ -130,6 +130,12 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
         return out;
       }
       (name == "t1" ? request.code_success : request.code_timeout) = value;
+    } else if (name == "exp") {
+      request.expires_at = strict_seed(value);  // the same rule: a plain whole number, no sign, no spaces
+      if (!request.expires_at) {
+        out.error = "exp '" + shown(value) + "' is not valid: use a Unix time in whole seconds";
+        return out;
+      }
     } else if (name == "seed") {
       request.seed = strict_seed(value);
       if (!request.seed) {

@@ -26,6 +26,9 @@ struct StartRequest {
   /// on timeout; identifiers, empty when the link has none.
   std::string code_success;
   std::string code_timeout;
+  /// `exp`: the link is valid until this Unix time, seconds (signed with the rest when links are signed);
+  /// unset = no expiry.
+  std::optional<std::uint64_t> expires_at;
 };
 
 /// The link parameters that override the scenario, with the sim_rfb flag each becomes.

@@ -287,3 +287,16 @@ TEST_CASE("completion codes t1 and t2 are identifiers, kept apart from the scena
   CHECK_FALSE(accepted("t2", std::string(65, 'x')));
   CHECK(parse_with("t1", "x;rm").error.find("t1") != std::string::npos);
 }
+
+TEST_CASE("exp is a Unix time in whole seconds, and nothing else") {
+  const StartParse parsed = parse_with("exp", "1798761600");
+  REQUIRE(parsed.request);
+  CHECK(parsed.request->expires_at == std::uint64_t{1798761600});
+  CHECK_FALSE(parse_start_request({{"uid", "p01"}}, kScenarios).request->expires_at);
+  for (const char* bad : {"", "-1", "+5", "1e9", " 17", "17 ", "0x10", "99999999999999999999"}) {
+    INFO(bad);
+    const StartParse refused = parse_with("exp", bad);
+    CHECK_FALSE(refused.request);
+    CHECK(refused.error.find("exp '") == 0);
+  }
+}
