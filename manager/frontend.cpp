@@ -148,9 +148,17 @@ class FrontendImpl final : public Frontend, public SessionListener {
       boost::system::error_code ignored;
       server_.get_con_from_hdl(hdl)->get_raw_socket().set_option(asio::ip::tcp::no_delay(true), ignored);
     });
-    server_.set_http_handler([this](connection_hdl hdl) { handle_http(server_.get_con_from_hdl(hdl)); });
-    server_.set_validate_handler([this](connection_hdl hdl) { return validate_websocket(server_.get_con_from_hdl(hdl)); });
-    server_.set_open_handler([this](connection_hdl hdl) { open_websocket(hdl); });
+    // No exception leaves a handler: a request that trips one costs its own connection, never the I/O loop
+    // that carries every session.
+    server_.set_http_handler([this](connection_hdl hdl) {
+      guarded("an HTTP request", hdl, [&] { handle_http(server_.get_con_from_hdl(hdl)); });
+    });
+    server_.set_validate_handler([this](connection_hdl hdl) {
+      bool accepted = false;
+      guarded("a WebSocket handshake", hdl, [&] { accepted = validate_websocket(server_.get_con_from_hdl(hdl)); });
+      return accepted;
+    });
+    server_.set_open_handler([this](connection_hdl hdl) { guarded("a WebSocket", hdl, [&] { open_websocket(hdl); }); });
     server_.set_close_handler([this](connection_hdl hdl) { forget_websocket(hdl); });
     server_.set_fail_handler([this](connection_hdl hdl) { forget_websocket(hdl); });
     server_.set_message_handler([this](connection_hdl hdl, typename Server::message_ptr message) {
@@ -308,6 +316,19 @@ class FrontendImpl final : public Frontend, public SessionListener {
     });
   }
 
+  // Runs `work` for connection `hdl`; an exception is logged and ends that connection only.
+  template <typename Work>
+  void guarded(const char* what, connection_hdl hdl, Work&& work) {
+    try {
+      work();
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "[manager] %s failed: %s; its connection is closed\n", what, error.what());
+      websocketpp::lib::error_code ec;
+      auto con = server_.get_con_from_hdl(hdl, ec);
+      if (!ec) con->terminate(ec);
+    }
+  }
+
   // SessionListener
   void session_ready(const Session& session) override {
     for (auto& [hdl, relay] : relays_) {
@@ -455,7 +476,27 @@ class FrontendImpl final : public Frontend, public SessionListener {
              "The study link is no longer valid. Please go back to the survey or contact the researcher.");
       return;
     }
-    const StartOutcome outcome = supervisor_.start(*parsed.request, address);
+    // A new session's answer waits for its index row, which is written off this thread: defer the response.
+    struct Answer {
+      bool given = false;
+      bool deferred = false;
+    };
+    const auto answer = std::make_shared<Answer>();  // the reply may come after this function returned
+    supervisor_.start(*parsed.request, address, [this, con, answer](const StartOutcome& outcome) {
+      answer->given = true;
+      answer_start(con, outcome);
+      if (answer->deferred) {
+        websocketpp::lib::error_code ec;
+        con->send_http_response(ec);  // a browser that left meanwhile costs nothing
+      }
+    });
+    if (!answer->given) {
+      answer->deferred = true;
+      con->defer_http_response();
+    }
+  }
+
+  void answer_start(const ConnectionPtr& con, const StartOutcome& outcome) {
     switch (outcome.kind) {
       case StartOutcome::Kind::kJoined:
       case StartOutcome::Kind::kStarted: {

@@ -111,6 +111,8 @@ int run(ManagerConfig config) {
   if (const int interrupted = supervisor.recover_interrupted(); interrupted > 0) {
     std::fprintf(stderr, "[manager] marked %d session(s) left by the previous run as interrupted\n", interrupted);
   }
+  // Before the first link: the index says what happened to the previous run's sessions.
+  supervisor.flush_index();
   const auto frontend = manager::make_frontend(io, config, supervisor, metrics, web_root);
   // Without signed links the uid is the only secret: anyone who learns or guesses one can start (or take
   // over) that participant's session. Fine on loopback; on a public address it should be a choice.
@@ -145,7 +147,16 @@ int run(ManagerConfig config) {
                static_cast<long long>(config.idle_timeout.count()), config.data_dir.c_str());
   std::printf("sim_manager ready: %s/\nparticipant link: %s/start?%s\n", base.c_str(), base.c_str(), example.c_str());
   std::fflush(stdout);
-  io.run();
+  // Handlers catch what they can; anything that still escapes is logged and the loop goes on, since every
+  // participant's relay lives on it.
+  for (;;) {
+    try {
+      io.run();
+      break;
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "[manager] error on the I/O loop: %s; carrying on\n", error.what());
+    }
+  }
   std::fprintf(stderr, "[manager] stopped\n");
   return 0;
 }

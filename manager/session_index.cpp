@@ -208,8 +208,8 @@ void SessionIndex::exec(const char* sql) {
 std::int64_t SessionIndex::insert(const Session& s) {
   Statement insert(db_,
                    "INSERT INTO sessions (uid, token, scenario, params, seed, host_id, state, detail, pid, "
-                   "process_start, port, data_path, created_at, code_success, code_timeout) "
-                   "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
+                   "process_start, port, data_path, created_at, code_success, code_timeout, spent_at, id) "
+                   "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
   insert.bind(1, s.uid);
   insert.bind(2, s.token);
   insert.bind(3, s.scenario);
@@ -225,8 +225,22 @@ std::int64_t SessionIndex::insert(const Session& s) {
   insert.bind(13, iso_utc(s.created));
   insert.bind(14, s.code_success);
   insert.bind(15, s.code_timeout);
+  insert.bind(16, s.spent_at);
+  if (s.id > 0) {
+    insert.bind(17, s.id);
+  } else {
+    insert.bind_null(17);  // SQLite picks the next id
+  }
   insert.step();
   return sqlite3_last_insert_rowid(db_);
+}
+
+std::int64_t SessionIndex::max_id() {
+  // AUTOINCREMENT's own record too: an id of a deleted row is never handed out again.
+  Statement select(db_,
+                   "SELECT MAX(COALESCE((SELECT MAX(id) FROM sessions), 0), "
+                   "COALESCE((SELECT seq FROM sqlite_sequence WHERE name = 'sessions'), 0))");
+  return select.step() ? select.integer(0) : 0;
 }
 
 void SessionIndex::update(const Session& s) {

@@ -25,8 +25,13 @@ class SessionIndex {
   SessionIndex(const SessionIndex&) = delete;
   SessionIndex& operator=(const SessionIndex&) = delete;
 
-  /// Inserts a new session and returns its id (session.id is ignored).
+  /// Inserts a new session and returns its id: session.id when it is above 0 (the caller chose it, see
+  /// max_id()), else a new one.
   std::int64_t insert(const Session& session);
+  /// The highest session id in the index (0 when empty): a manager hands out ids above it.
+  std::int64_t max_id();
+  /// The file this index lives in.
+  [[nodiscard]] const std::string& path() const { return path_; }
   /// Writes a session's mutable fields (state, detail, exit status, pid, process start, port, data path,
   /// times) to its row.
   void update(const Session& session);

@@ -150,9 +150,17 @@ struct OwnedFd {
   sigemptyset(&default_action.sa_mask);
   for (const int sig : {SIGPIPE, SIGINT, SIGTERM, SIGCHLD, SIGHUP}) ::sigaction(sig, &default_action, nullptr);
 
+  // Never above the hard limit we inherited: without privileges raising it fails, and a limit lower than asked
+  // for is still a limit (a manager under `ulimit -Hn 512` must still start sessions).
   const auto limit = [&](int resource, std::uint64_t soft, std::uint64_t hard) {
     if (soft == 0) return;
-    const rlimit value{static_cast<rlim_t>(soft), static_cast<rlim_t>(hard)};
+    rlimit inherited{};
+    if (::getrlimit(resource, &inherited) != 0) fail(2);
+    const auto cap = [&](std::uint64_t value) {
+      const auto wanted = static_cast<rlim_t>(value);
+      return inherited.rlim_max == RLIM_INFINITY || wanted <= inherited.rlim_max ? wanted : inherited.rlim_max;
+    };
+    const rlimit value{cap(soft), cap(hard)};
     if (::setrlimit(resource, &value) != 0) fail(2);
   };
   limit(RLIMIT_AS, spec.limits.address_space_bytes, spec.limits.address_space_bytes);

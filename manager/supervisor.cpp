@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/posix/stream_descriptor.hpp>
@@ -114,12 +115,18 @@ Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::s
       index_(index),
       metrics_(metrics),
       table_(config.max_sessions),
-      child_watch_(std::make_unique<ChildWatch>(io)) {
+      child_watch_(std::make_unique<ChildWatch>(io)),
+      writer_(std::make_unique<IndexWriter>(index.path())) {
   if (config_.session_kind == SessionKind::kSimRfb && config_.session_socket == "unix") socket_dir_ = make_socket_dir();
+  next_id_ = index_.max_id() + 1;
+  for (const auto& [state, count] : index_.count_by_state()) {
+    if (!is_live(state)) ended_counts_[state] = count;
+  }
   wait_for_children();
 }
 
 Supervisor::~Supervisor() {
+  writer_.reset();  // writes what is queued
   if (socket_dir_.empty()) return;
   std::error_code ignored;
   std::filesystem::remove_all(socket_dir_, ignored);
@@ -136,31 +143,26 @@ void Supervisor::wait_for_children() {
 Supervisor::Runtime& Supervisor::runtime(std::int64_t id) { return *runtimes_.at(id); }
 
 void Supervisor::save(const Session& session) {
-  try {
-    index_.update(session);
-  } catch (const std::exception& error) {
-    log_session(session, std::string("cannot write the index: ") + error.what());
-  }
-  write_record(session);
+  // The table (or the caller) has the newest version now; the index gets it in order, off this thread.
+  const std::uint64_t sequence = ++write_sequence_;
+  unsaved_[session.id] = {sequence, session};
+  writer_->update(session, [this, id = session.id, sequence](const std::string& error) {
+    asio::post(io_, [this, id, sequence, error] {
+      const auto it = unsaved_.find(id);
+      if (!error.empty()) {
+        std::fprintf(stderr, "[manager] session %lld: %s\n", static_cast<long long>(id), error.c_str());
+      }
+      if (it != unsaved_.end() && it->second.first == sequence) unsaved_.erase(it);
+    });
+  });
 }
 
-// manager.json beside the session's data: replaced whole (a temporary file renamed over it), so a reader never
-// sees half of one. Not synced: the index is the durable record, this is a convenience copy for the tools.
-void Supervisor::write_record(const Session& session) {
-  if (session.data_path.empty()) return;
-  const std::filesystem::path target = std::filesystem::path(session.data_path) / "manager.json";
-  const std::filesystem::path temporary = std::filesystem::path(session.data_path) / ".manager.json.tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << session_record_json(session);
-    if (!out.flush()) {
-      log_session(session, "cannot write " + target.string());
-      return;
-    }
+std::optional<Session> Supervisor::latest_for_uid(const std::string& uid) {
+  std::optional<Session> latest = index_.latest_for_uid(uid);
+  for (const auto& [id, queued] : unsaved_) {
+    if (queued.second.uid == uid && (!latest || id >= latest->id)) latest = queued.second;
   }
-  std::error_code ec;
-  std::filesystem::rename(temporary, target, ec);
-  if (ec) log_session(session, "cannot write " + target.string() + ": " + ec.message());
+  return latest;
 }
 
 int Supervisor::recover_interrupted() {
@@ -187,37 +189,43 @@ int Supervisor::recover_interrupted() {
     session.detail = "the manager stopped unexpectedly while the session ran";
     session.ended_at = std::chrono::system_clock::now();
     save(session);
+    ++ended_counts_[SessionState::kInterrupted];
   }
   return static_cast<int>(left.size());
 }
 
-StartOutcome Supervisor::start(const StartRequest& request, const std::string& address) {
+void Supervisor::start(const StartRequest& request, const std::string& address, StartReply reply) {
   StartOutcome outcome;
   Session* live = table_.by_uid(request.uid);
   if (live != nullptr && live->state == SessionState::kEnding) {
     outcome.kind = StartOutcome::Kind::kBusy;  // a few seconds from gone: the busy page retries
-    return outcome;
+    reply(outcome);
+      return;
   }
   std::optional<SessionState> last;
   if (live == nullptr) {
     try {
-      if (const auto latest = index_.latest_for_uid(request.uid)) last = latest->state;
+      if (const auto latest = latest_for_uid(request.uid)) last = latest->state;
     } catch (const std::exception& error) {
       outcome.message = std::string("the session index cannot be read: ") + error.what();
-      return outcome;
+      reply(outcome);
+      return;
     }
   }
   switch (admit(live != nullptr, last, config_.allow_repeat, table_.full() || shutting_down_)) {
     case Admission::kJoinLive:
       outcome.kind = StartOutcome::Kind::kJoined;
       outcome.token = live->token;
-      return outcome;
+      reply(outcome);
+      return;
     case Admission::kAlreadyCompleted:
       outcome.kind = StartOutcome::Kind::kCompleted;
-      return outcome;
+      reply(outcome);
+      return;
     case Admission::kBusy:
       outcome.kind = StartOutcome::Kind::kBusy;
-      return outcome;
+      reply(outcome);
+      return;
     case Admission::kStartNew:
       break;
   }
@@ -231,7 +239,8 @@ StartOutcome Supervisor::start(const StartRequest& request, const std::string& a
     }
     if (unspent >= unspent_cap) {
       outcome.kind = StartOutcome::Kind::kTooManyUnspent;
-      return outcome;
+      reply(outcome);
+      return;
     }
   }
 
@@ -247,13 +256,9 @@ StartOutcome Supervisor::start(const StartRequest& request, const std::string& a
   session.start_address = address;
   session.created = std::chrono::system_clock::now();
   const auto started = SteadyClock::now();
-  // The row first: whatever happens next, the index knows this session existed.
-  try {
-    session.id = index_.insert(session);
-  } catch (const std::exception& error) {
-    outcome.message = std::string("the session index cannot be written: ") + error.what();
-    return outcome;
-  }
+  // Ids are handed out here, so that the row can be written off this thread; the participant is redirected
+  // only once it is committed (below), so a redirect always points at a recorded session.
+  session.id = next_id_++;
 
   LaunchContext context;
   context.seed = session.seed;
@@ -286,15 +291,16 @@ StartOutcome Supervisor::start(const StartRequest& request, const std::string& a
     session.state = SessionState::kFailed;
     session.detail = error.what();
     session.ended_at = std::chrono::system_clock::now();
-    save(session);
+    insert_row(session, nullptr);
+    ++ended_counts_[SessionState::kFailed];
     log_session(session, std::string("could not start: ") + error.what());
     metrics_.count_rejection(Rejection::kStartFailed);
     outcome.message = error.what();
-    return outcome;
+    reply(outcome);
+      return;
   }
   session.pid = process.pid;
   session.process_start = process.start_ticks;
-  save(session);
   metrics_.count_start();
   log_session(session, "started " + std::string(config_.session_kind == SessionKind::kSimRfb ? "sim_rfb" : "program") +
                            " as pid " + std::to_string(process.pid) + " in " + session.data_path);
@@ -326,7 +332,32 @@ StartOutcome Supervisor::start(const StartRequest& request, const std::string& a
   }
   outcome.kind = StartOutcome::Kind::kStarted;
   outcome.token = kept.token;
-  return outcome;
+  // The row, with the process in it; the redirect once it is committed. If the index cannot take it, the
+  // session cannot be recorded and must not run.
+  insert_row(kept, [this, id, outcome, reply = std::move(reply)](const std::string& error) {
+    if (error.empty()) {
+      reply(outcome);
+      return;
+    }
+    if (Session* s = table_.by_id(id)) begin_end(*s, SessionState::kFailed, error);
+    StartOutcome failed;
+    failed.message = error;
+    reply(failed);
+  });
+}
+
+void Supervisor::insert_row(const Session& session, std::function<void(const std::string&)> committed) {
+  const std::uint64_t sequence = ++write_sequence_;
+  unsaved_[session.id] = {sequence, session};
+  writer_->insert(session, [this, id = session.id, sequence, committed = std::move(committed)](
+                               const std::string& error) {
+    asio::post(io_, [this, id, sequence, error, committed] {
+      const auto it = unsaved_.find(id);
+      if (it != unsaved_.end() && it->second.first == sequence) unsaved_.erase(it);
+      if (!error.empty()) std::fprintf(stderr, "[manager] session %lld: %s\n", static_cast<long long>(id), error.c_str());
+      if (committed) committed(error);
+    });
+  });
 }
 
 void Supervisor::watch_ready_pipe(Session& session) {
@@ -510,6 +541,7 @@ void Supervisor::process_gone(Session& session, int wait_status) {
   }
   session.state = final_state;
   session.ended_at = std::chrono::system_clock::now();
+  ++ended_counts_[final_state];
   // A killed sim_rfb leaves its socket file behind.
   if (!session.unix_socket.empty()) {
     std::error_code ignored;
@@ -586,6 +618,9 @@ void Supervisor::shutdown(std::function<void()> done) {
 
 std::optional<Session> Supervisor::find(const std::string& token) {
   if (Session* live = table_.by_token(token)) return *live;
+  for (const auto& [id, queued] : unsaved_) {
+    if (queued.second.token == token) return queued.second;
+  }
   try {
     return index_.find_by_token(token);
   } catch (const std::exception& error) {
@@ -595,16 +630,25 @@ std::optional<Session> Supervisor::find(const std::string& token) {
 }
 
 std::map<SessionState, std::int64_t> Supervisor::counts_by_state() {
-  std::map<SessionState, std::int64_t> counts;
-  try {
-    for (const auto& [state, count] : index_.count_by_state()) {
-      if (!is_live(state)) counts[state] = count;
-    }
-  } catch (const std::exception& error) {
-    std::fprintf(stderr, "[manager] cannot read the index: %s\n", error.what());
-  }
+  std::map<SessionState, std::int64_t> counts = ended_counts_;
   for (Session* session : table_.all()) ++counts[session->state];
   return counts;
+}
+
+std::vector<Session> Supervisor::recent(int limit) {
+  std::vector<Session> rows = index_.recent(limit);
+  // Rows still queued for the writer: their newest version replaces the index's, or joins the list.
+  for (const auto& [id, queued] : unsaved_) {
+    const auto row = std::find_if(rows.begin(), rows.end(), [id = id](const Session& r) { return r.id == id; });
+    if (row != rows.end()) {
+      *row = queued.second;
+    } else {
+      rows.push_back(queued.second);
+    }
+  }
+  std::sort(rows.begin(), rows.end(), [](const Session& a, const Session& b) { return a.id > b.id; });
+  if (rows.size() > static_cast<std::size_t>(std::max(limit, 0))) rows.resize(static_cast<std::size_t>(std::max(limit, 0)));
+  return rows;
 }
 
 }  // namespace rfbsim::manager

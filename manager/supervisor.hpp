@@ -15,6 +15,7 @@
 #include <string>
 
 #include "config.hpp"
+#include "index_writer.hpp"
 #include "metrics.hpp"
 #include "session_index.hpp"
 #include "session_table.hpp"
@@ -56,8 +57,12 @@ class Supervisor {
   /// run) and marks those sessions interrupted. Returns how many there were.
   int recover_interrupted();
 
+  /// What /start answers with, called on the I/O thread.
+  using StartReply = std::function<void(const StartOutcome&)>;
   /// Admits a valid link from client `address`: back to the uid's live session, or a new one, or why not.
-  StartOutcome start(const StartRequest& request, const std::string& address = "");
+  /// `reply` is called at once, except for a new session: then once its index row is committed (on the
+  /// writer's thread, posted back), so that a redirect always points at a recorded session.
+  void start(const StartRequest& request, const std::string& address, StartReply reply);
 
   /// A browser connected to / disconnected from a session (the idle timer counts from the last one gone).
   void client_connected(std::int64_t id);
@@ -77,10 +82,14 @@ class Supervisor {
   SessionTable& table() { return table_; }
   /// A session by token: live, else from the index.
   std::optional<Session> find(const std::string& token);
-  /// The newest `limit` sessions from the index, newest first (throws std::runtime_error on index errors).
-  std::vector<Session> recent(int limit) { return index_.recent(limit); }
-  /// Sessions by state: live ones from the table, ended ones from the whole index.
+  /// The newest `limit` sessions, newest first: the index, with writes still queued taken into account
+  /// (throws std::runtime_error on index errors).
+  std::vector<Session> recent(int limit);
+  /// Sessions by state: live ones from the table, ended ones counted in memory (read from the index once, at
+  /// start): /metrics must be cheap.
   std::map<SessionState, std::int64_t> counts_by_state();
+  /// Blocks until every queued index write is done (tests and shutdown).
+  void flush_index() { writer_->drain(); }
 
  private:
   struct Runtime;
@@ -97,7 +106,11 @@ class Supervisor {
   void process_gone(Session& session, int wait_status);
   void arm_idle_timer(Session& session);
   void save(const Session& session);
-  void write_record(const Session& session);
+  // Queues a session's first row; `committed` (may be empty) runs on the I/O thread once it is written ("" or
+  // the error).
+  void insert_row(const Session& session, std::function<void(const std::string&)> committed);
+  // The uid's newest session in the index or among writes still queued.
+  std::optional<Session> latest_for_uid(const std::string& uid);
   std::string session_log_tail(const Session& session) const;
   Runtime& runtime(std::int64_t id);
 
@@ -114,6 +127,13 @@ class Supervisor {
   std::function<void()> on_all_gone_;  // set by shutdown()
   bool shutting_down_ = false;
   std::string socket_dir_;  // private folder (0700) of the sessions' unix sockets; "" = they use TCP ports
+  std::unique_ptr<IndexWriter> writer_;  // the index's writes, off this thread
+  std::int64_t next_id_ = 1;             // session ids are handed out here, above the index's highest
+  // Sessions whose latest version is queued for the writer, by id: (write sequence, that version). Reads of
+  // the index look here first, so that they never see an older row than the table did.
+  std::map<std::int64_t, std::pair<std::uint64_t, Session>> unsaved_;
+  std::uint64_t write_sequence_ = 0;
+  std::map<SessionState, std::int64_t> ended_counts_;  // ended sessions by state, whole index
 };
 
 }  // namespace rfbsim::manager

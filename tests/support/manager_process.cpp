@@ -142,7 +142,19 @@ std::string ManagerUnderTest::state_of(const std::string& token, bool tls) const
 
 bool ManagerUnderTest::wait_for_state(const std::string& token, const std::string& state,
                                       std::chrono::milliseconds timeout, bool tls) const {
-  return eventually([&] { return state_of(token, tls) == state; }, timeout, options_.poll_interval);
+  // The index is written off the manager's I/O thread, a moment after the page's status changes: wait for both,
+  // so that a test reading the row next sees the state it waited for.
+  return eventually(
+      [&] {
+        if (state_of(token, tls) != state) return false;
+        try {
+          const auto row = row_for_token(token);
+          return row && row->state == state;
+        } catch (const std::exception&) {
+          return false;  // the index is not there yet
+        }
+      },
+      timeout, options_.poll_interval);
 }
 
 std::vector<IndexRow> ManagerUnderTest::query_index(const std::optional<std::string>& token) const {

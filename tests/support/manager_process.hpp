@@ -99,7 +99,7 @@ class ManagerUnderTest {
 
   /// The session state reported by /s/<token>/status ("" if the request fails).
   std::string state_of(const std::string& token, bool tls = false) const;
-  /// Polls /s/<token>/status until it reports `state` or `timeout` passes.
+  /// Polls /s/<token>/status and the index until both report `state`, or `timeout` passes.
   bool wait_for_state(const std::string& token, const std::string& state,
                       std::chrono::milliseconds timeout = std::chrono::seconds(20), bool tls = false) const;
 

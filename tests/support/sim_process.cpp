@@ -7,6 +7,7 @@
 #include <signal.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -43,6 +44,9 @@ Spawned spawn(const std::string& program, const std::vector<std::string>& args, 
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
+    // A test that dies on a signal never runs its destructors: its child must not outlive it and hold ctest's
+    // output pipe open until the timeout.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     ::dup2(pipe_fds[1], STDOUT_FILENO);
     if (with_stderr) ::dup2(pipe_fds[1], STDERR_FILENO);
     ::execv(program.c_str(), argv.data());

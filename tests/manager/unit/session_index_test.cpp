@@ -114,9 +114,13 @@ TEST_CASE("insert returns increasing ids and a new index is empty") {
   CHECK_FALSE(index.latest_for_uid("p01"));
   CHECK(index.insert(make("p01")) == 1);
   CHECK(index.insert(make("p02")) == 2);
+  CHECK(index.max_id() == 2);
+  // An id the caller chose (the manager hands them out itself, to write rows off its I/O thread).
   Session with_id = make("p03");
-  with_id.id = 77;  // ignored
-  CHECK(index.insert(with_id) == 3);
+  with_id.id = 77;
+  CHECK(index.insert(with_id) == 77);
+  CHECK(index.max_id() == 77);
+  CHECK(index.insert(make("p04")) == 78);
 }
 
 TEST_CASE("a token is unique in the index") {
