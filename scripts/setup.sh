@@ -19,7 +19,7 @@ while [ $# -gt 0 ]; do
   shift
 done
 
-# Debian packages: the build's libraries and tools. Chromium only for the browser tests.
+# Debian packages: the build's libraries and tools.
 packages=(build-essential cmake ninja-build pkg-config git
   libvncserver-dev libegl-dev libgl-dev libopengl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm-dev
   libode-dev libyaml-cpp-dev libpng-dev libeigen3-dev libwebsocketpp-dev libboost-system-dev libasio-dev catch2 libssl-dev libsqlite3-dev
@@ -27,7 +27,8 @@ packages=(build-essential cmake ninja-build pkg-config git
   ffmpeg)
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)
-[ "$with_browser" = 1 ] && packages+=(chromium)
+# Test-only: Chromium for the browser tests, clang and its runtimes (libFuzzer, sanitizers) for scripts/fuzz.sh.
+[ "$with_browser" = 1 ] && packages+=(chromium clang libclang-rt-14-dev)
 
 missing=()
 for p in "${packages[@]}"; do

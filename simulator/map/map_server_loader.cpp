@@ -13,6 +13,8 @@
 #include <string>
 #include <string_view>
 
+#include "map/yaml_limits.hpp"
+
 namespace rfbsim::sim {
 namespace {
 
@@ -77,9 +79,15 @@ YAML::Node parse_yaml_file(const std::filesystem::path& file) {
   for (std::size_t got = 0; (got = std::fread(buffer, 1, sizeof buffer, f.get())) > 0;) {
     text.append(buffer, got);
     // A map's YAML is a few lines; anything this large is not one, and we will not hold it.
-    if (text.size() > 1'000'000) throw MapLoadError(name + ": too large for a map YAML file (over 1 MB)");
+    if (text.size() > kMaxYamlBytes) {
+      throw MapLoadError(name + ": too large for a map YAML file (over " + std::to_string(kMaxYamlBytes) + " bytes)");
+    }
   }
   if (std::ferror(f.get()) != 0) throw MapLoadError(name + ": cannot read: " + std::strerror(errno));
+  // yaml-cpp recurses once per level of nesting: refuse deep text before it does.
+  if (const std::string problem = yaml_limits_problem(text); !problem.empty()) {
+    throw MapLoadError(name + ": " + problem);
+  }
   try {
     return YAML::Load(text);
   } catch (const YAML::Exception& e) {

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "map/yaml_limits.hpp"
 #include "scenario/scenario.hpp"
 
 namespace rfbsim::sim {
@@ -146,10 +147,20 @@ std::vector<std::pair<std::string, YamlField>> YamlField::mapping() const {
 YamlField read_yaml_file(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw ScenarioError(file.string() + ": cannot open the file");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read in blocks and stop past the limit, so that a huge file (or /dev/zero) is refused without being held.
+  std::string text;
+  char block[4096];
+  while (in.read(block, sizeof block) || in.gcount() > 0) {
+    text.append(block, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxYamlBytes) break;
+  }
+  if (in.bad()) throw ScenarioError(file.string() + ": cannot read the file");
+  // yaml-cpp recurses once per level of nesting: refuse deep text before it does.
+  if (const std::string problem = yaml_limits_problem(text); !problem.empty()) {
+    throw ScenarioError(file.string() + ": " + problem);
+  }
   try {
-    return YamlField(YAML::Load(text.str()), file);
+    return YamlField(YAML::Load(text), file);
   } catch (const YAML::Exception& e) {
     throw ScenarioError(file.string() + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
                         ": not valid YAML: " + e.msg);

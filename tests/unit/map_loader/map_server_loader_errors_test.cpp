@@ -167,3 +167,13 @@ TEST_CASE("map_server_loader errors: pictures that are missing, truncated, garba
   dir.write("cut.png", std::string("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0", 18));
   CHECK(try_image("cut.png").find("(" + dir.path("cut.png").string() + "): bad PNG: ") != std::string::npos);
 }
+
+TEST_CASE("map_server_loader errors: deep or huge YAML is refused before yaml-cpp parses it") {
+  // yaml-cpp recurses once per level; 100000 brackets would cost it deep recursion before its own guard.
+  CHECK(error_for(std::string(100000, '[')) == ": YAML nested more than 32 levels deep (line 1)");
+  std::string dashes;
+  for (int i = 0; i < 40; ++i) dashes += "- ";
+  CHECK(error_for(kGood + "extra:\n  " + dashes + "x\n") == ": YAML nested more than 32 levels deep (line 8)");
+  CHECK(error_for(kGood + "# " + std::string(1'000'001, 'x') + "\n") ==
+        ": too large for a map YAML file (over 1000000 bytes)");
+}

@@ -146,6 +146,17 @@ TEST_CASE("a map image that cannot be read is reported through the scenario's ma
   CHECK_THAT(scratch.error_of(kValid), Catch::Contains("room.pgm"));
 }
 
+TEST_CASE("scenario text too deep or too large for yaml-cpp is refused with the limit, before parsing") {
+  ScratchScenario scratch;
+  const std::string deep = kValid + "props: " + std::string(100000, '[') + "\n";
+  CHECK_THAT(scratch.error_of(deep), Catch::Contains("s.yaml: YAML nested more than 32 levels deep (line 7)"));
+  std::string nested = kValid + "extra:\n";
+  for (int level = 1; level <= 40; ++level) nested += std::string(static_cast<std::size_t>(2 * level), ' ') + "k:\n";
+  CHECK_THAT(scratch.error_of(nested), Catch::Contains("s.yaml: YAML nested more than 32 levels deep"));
+  CHECK_THAT(scratch.error_of(kValid + "# " + std::string(1'000'001, 'x') + "\n"),
+             Catch::Contains("s.yaml: too large for a YAML file here (over 1000000 bytes)"));
+}
+
 TEST_CASE("no file is read when the scenario file itself is missing") {
   try {
     (void)load_scenario("/nonexistent/dir/s.yaml");
