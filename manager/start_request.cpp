@@ -44,7 +44,8 @@ std::optional<double> strict_decimal(std::string_view text) {
 }
 
 bool is_count(std::string_view text, int high) {
-  if (text.empty() || text.size() > 4) return false;
+  // Digits only: from_chars alone would take "-0".
+  if (text.empty() || text.size() > 4 || text.front() < '0' || text.front() > '9') return false;
   int value = 0;
   const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   return ec == std::errc() && ptr == text.data() + text.size() && value >= 0 && value <= high;

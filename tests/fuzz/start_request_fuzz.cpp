@@ -22,16 +22,13 @@ std::size_t override_index(const std::string& name) {
   return kOverrideParams.size();
 }
 
-// A crowd size as the link's rule says: a whole number 0..500 in at most 4 digits. std::from_chars, which
-// the parser uses, also reads "-0" (as 0, which sim_rfb's own --crowd reads the same), so that one is let by.
+// A crowd size as the link's rule says: a whole number 0..500 in at most 4 digits, digits only.
 bool is_count(const std::string& value) {
-  const std::string digits = value.rfind('-', 0) == 0 ? value.substr(1) : value;
-  if (digits.empty() || digits.size() > 4) return false;
-  for (const char ch : digits) {
+  if (value.empty() || value.size() > 4) return false;
+  for (const char ch : value) {
     if (ch < '0' || ch > '9') return false;
   }
-  const int count = std::stoi(digits);
-  return count <= 500 && (digits.size() == value.size() || count == 0);
+  return std::stoi(value) <= 500;
 }
 
 }  // namespace

@@ -300,3 +300,11 @@ TEST_CASE("exp is a Unix time in whole seconds, and nothing else") {
     CHECK(refused.error.find("exp '") == 0);
   }
 }
+
+TEST_CASE("a crowd size is digits only: no sign, not even on zero") {
+  CHECK(accepted("crowd", "0"));
+  CHECK(accepted("crowd", "500"));
+  CHECK_FALSE(accepted("crowd", "-0"));
+  CHECK_FALSE(accepted("crowd", "+1"));
+  CHECK_FALSE(accepted("crowd", "501"));
+}
