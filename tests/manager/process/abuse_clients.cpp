@@ -398,22 +398,6 @@ std::string index_column(const std::filesystem::path& data_dir, const std::strin
   return value;
 }
 
-ScopedEnv::ScopedEnv(std::string name, const std::string& value) : name_(std::move(name)) {
-  if (const char* old = std::getenv(name_.c_str())) {
-    had_ = true;
-    old_ = old;
-  }
-  ::setenv(name_.c_str(), value.c_str(), 1);
-}
-
-ScopedEnv::~ScopedEnv() {
-  if (had_) {
-    ::setenv(name_.c_str(), old_.c_str(), 1);
-  } else {
-    ::unsetenv(name_.c_str());
-  }
-}
-
 LowDescriptorReserve::LowDescriptorReserve(int count) {
   for (int i = 0; i < count; ++i) {
     const int fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "http_client.hpp"
+#include "scoped_env.hpp"
 
 namespace rfbsim::test::abuse {
 
@@ -136,21 +137,8 @@ long resident_kib(pid_t pid);
 /// One text column of the index row of session `token` in `data_dir`/sessions.db ("" for NULL or no row).
 std::string index_column(const std::filesystem::path& data_dir, const std::string& token, const std::string& column);
 
-/// Sets an environment variable for this object's life (children started meanwhile inherit it).
-class ScopedEnv {
- public:
-  /// Sets `name` to `value`, remembering what was there.
-  ScopedEnv(std::string name, const std::string& value);
-  /// Puts back the earlier value, or unsets it.
-  ~ScopedEnv();
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  std::string name_;
-  bool had_ = false;
-  std::string old_;
-};
+/// The shared ScopedEnv (tests/support/scoped_env.hpp), under this file's namespace as the tests use it.
+using rfbsim::test::ScopedEnv;
 
 /// Low descriptor numbers held free for later: libvncclient waits with select(), which aborts on a descriptor
 /// at or above FD_SETSIZE (1024), so a test that opens thousands of sockets keeps some low ones for its client.

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "scoped_env.hpp"
 #include "manager_process.hpp"
 #include "sim_process.hpp"
 
@@ -29,28 +30,7 @@ namespace {
 constexpr const char* kAdminToken = "env-admin-token-0123456789";
 constexpr const char* kLinkSecret = "env-link-secret-0123456789";
 
-// Sets a variable of this process for the scope (the manager started inside it inherits it), restoring the
-// earlier value or its absence after.
-class ScopedVariable {
- public:
-  ScopedVariable(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    ::setenv(name, value, 1);
-  }
-  ~ScopedVariable() {
-    if (old_) {
-      ::setenv(name_, old_->c_str(), 1);
-    } else {
-      ::unsetenv(name_);
-    }
-  }
-  ScopedVariable(const ScopedVariable&) = delete;
-  ScopedVariable& operator=(const ScopedVariable&) = delete;
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
+using rfbsim::test::ScopedEnv;
 
 // The whole content of a /proc file.
 std::string read_proc(const std::string& path) {
@@ -93,10 +73,10 @@ TEST_CASE("a session inherits none of the manager's secrets, only its allow-list
   TempDir data;
   std::optional<ManagerUnderTest> manager;
   {
-    const ScopedVariable admin("RFBSIM_ADMIN_TOKEN", kAdminToken);
-    const ScopedVariable secret("RFBSIM_LINK_SECRET", kLinkSecret);
-    const ScopedVariable foo("FOO", "bar");
-    const ScopedVariable key("RFBSIM_ADDRESS_KEY", "study-key-for-the-test");
+    const ScopedEnv admin("RFBSIM_ADMIN_TOKEN", kAdminToken);
+    const ScopedEnv secret("RFBSIM_LINK_SECRET", kLinkSecret);
+    const ScopedEnv foo("FOO", "bar");
+    const ScopedEnv key("RFBSIM_ADDRESS_KEY", "study-key-for-the-test");
     manager.emplace(data.path(), with_small_sessions({}));
   }
   // The test means something only if the manager itself holds the secrets.

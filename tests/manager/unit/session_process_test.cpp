@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "scoped_env.hpp"
 #include "scratch_dir.hpp"
 #include "session_process.hpp"
 
@@ -396,27 +397,7 @@ SpawnSpec in_folder(const std::string& folder) {
   return spec;
 }
 
-// Sets a variable of this process for the scope, restoring the earlier value (or its absence) after.
-class ScopedVariable {
- public:
-  ScopedVariable(const char* name, const char* value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    ::setenv(name, value, 1);
-  }
-  ~ScopedVariable() {
-    if (old_) {
-      ::setenv(name_, old_->c_str(), 1);
-    } else {
-      ::unsetenv(name_);
-    }
-  }
-  ScopedVariable(const ScopedVariable&) = delete;
-  ScopedVariable& operator=(const ScopedVariable&) = delete;
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
+using rfbsim::test::ScopedEnv;
 
 }  // namespace
 
@@ -484,10 +465,10 @@ TEST_CASE("the manager's secrets are refused by name, whoever asks for them") {
 
 TEST_CASE("a real session sees only its allow-listed environment, no core limit and umask 077") {
   ScratchDir dir;
-  const ScopedVariable token("RFBSIM_ADMIN_TOKEN", "secret-admin-token-123");
-  const ScopedVariable link("RFBSIM_LINK_SECRET", "secret-link-key-456");
-  const ScopedVariable foo("FOO", "bar");
-  const ScopedVariable key("RFBSIM_ADDRESS_KEY", "study-key");
+  const ScopedEnv token("RFBSIM_ADMIN_TOKEN", "secret-admin-token-123");
+  const ScopedEnv link("RFBSIM_LINK_SECRET", "secret-link-key-456");
+  const ScopedEnv foo("FOO", "bar");
+  const ScopedEnv key("RFBSIM_ADDRESS_KEY", "study-key");
   SpawnSpec spec = shell(dir, "");
   spec.program = "/usr/bin/env";  // the environment as exec gave it, with no shell adding its own variables
   spec.args = {};
