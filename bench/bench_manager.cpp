@@ -6,28 +6,32 @@
 //   1. Link to first frame: GET /start with a fresh uid, then, as soon as the 302 arrives, a client on the
 //      redirect's WebSocket; time to the first complete framebuffer update, split into stages. Each
 //      session is ended through the admin API, and gone, before the next link.
-//   2. Relay cost per update: two clients on one session, A through a bridge straight to the session's
-//      own port (sim_rfb speaks WebSocket itself), B through a bridge to the manager. Each pumps on its
+//   2. Relay cost per update: two clients on one session, A through a bridge to the session's own port
+//      (sim_rfb speaks WebSocket itself; a forwarder adds the PROXY line sessions expect first, as the relay
+//      does), B through a bridge to the manager. Each pumps on its
 //      own thread and records when each update completed, a hash of its picture after it and a small
 //      thumbnail of it. Updates of A and B that show the same frame are paired, and t_B - t_A is what the
 //      manager's hop added. Bit-identical pictures are rare (see picture_thumb), so frames are paired by
 //      thumbnail; the hash only counts how many pairs were also bit-identical.
 //   3. Capacity: sessions at 20 fps added one at a time, each watched by one client through the relay;
 //      after each, every client's updates per second, until the slowest falls below 19.
-// Tables 1 and 2 share one manager; table 3 has its own (the frame rate is a manager-wide session arg).
+// Each table has a manager of its own: table 2's with --session-socket tcp (client A needs the session's port),
+// table 3's with --fps 20 (the frame rate is a manager-wide session arg).
+// Two further modes replace these three: --soak MINUTES (manager_soak.hpp: sessions cycled through the relay
+// while the manager's memory and descriptors are sampled) and --abuse (manager_abuse.hpp: a participant's first
+// frame and frame rate on an idle manager and under a /start storm with thousands of half-open sockets).
 // The manager runs as rfbsim::test::ManagerUnderTest (tests/support, shared with the manager's process tests);
 // the clients and their fingerprints are in manager_clients.hpp.
+#include <arpa/inet.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <ctime>
 #include <exception>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -36,8 +40,12 @@
 
 #include "bench_util.hpp"
 #include "http_client.hpp"
+#include "manager_abuse.hpp"
 #include "manager_clients.hpp"
 #include "manager_process.hpp"
+#include "manager_session.hpp"
+#include "manager_soak.hpp"
+#include "proxy_line_forwarder.hpp"
 
 namespace {
 
@@ -48,6 +56,10 @@ using bench::Clock;
 using bench::WatchedClient;
 using rfbsim::test::IndexRow;
 using rfbsim::test::ManagerUnderTest;
+using bench::end_session;
+using bench::is_live_state;
+using bench::start_session;
+using bench::wait_for_row;
 using std::chrono::milliseconds;
 
 constexpr auto kFirstUpdateTimeout = milliseconds(30000);  // link to first update, and session start
@@ -61,7 +73,9 @@ constexpr auto kCapacityWarmUp = milliseconds(2000);
 constexpr auto kCapacityWindow = milliseconds(5000);
 constexpr double kCapacityFps = 20.0;
 constexpr double kCapacityFloor = 19.0;  // 20 fps less a jitter allowance
-const std::string kAdminToken = "bench-manager-admin-0123";  // 24 characters; loopback only
+// Soak sessions: the scenario's default 1280x720 at 15 fps, half the renderer's work at the default 30 (the
+// relay's work per frame is the same), so that a long soak leaves the shared machine some room.
+const std::vector<std::string> kSoakSessionArgs = {"--fps", "15"};
 
 struct Options {
   int sessions = 20;
@@ -71,12 +85,23 @@ struct Options {
   bool skip_capacity = false;
   std::string manager = rfbsim::test::sim_manager_path();  // $RFBSIM_SIM_MANAGER, or the one built here
   std::string log = (std::filesystem::temp_directory_path() / "rfbsim_bench_manager.log").string();
+  bool soak = false;  // --soak MINUTES given: run the soak instead of tables 1-3
+  bench::SoakOptions soak_options;
+  bool abuse = false;  // --abuse given: run the abuse comparison instead of tables 1-3
+  bench::AbuseOptions abuse_options;
 };
 
 constexpr const char* kUsage =
     "usage: bench_manager [--sessions N] [--scenario NAME] [--seconds S] [--max-capacity N] [--skip-capacity]\n"
     "                     [--manager PATH] [--log PATH]\n"
-    "Measures sim_manager: link to first frame, the relay's cost per update, sessions at 20 fps (loopback).\n";
+    "       bench_manager --soak MINUTES [--sessions-per-minute N] [--soak-max-sessions N] [--watch-seconds S]\n"
+    "       bench_manager --abuse [--abuse-repetitions N] [--abuse-seconds S] [--half-open N]\n"
+    "                     [--abuse-from ADDR] [--storm-per-second N]\n"
+    "Measures sim_manager: link to first frame, the relay's cost per update, sessions at 20 fps (loopback).\n"
+    "--soak cycles sessions through the relay for MINUTES (default 10 per minute, 4 at once, 5 s of frames each)\n"
+    "and samples the manager's RSS and descriptors every 10 s. --abuse compares a participant's first frame and\n"
+    "frame rate on an idle manager with the same while ADDR (default 127.0.0.2) holds N (2000) half-open sockets\n"
+    "and hammers /start. Both can be given (soak first); either replaces the three default measurements.\n";
 
 Options parse_options(int argc, char** argv) {
   Options o;
@@ -88,6 +113,10 @@ Options parse_options(int argc, char** argv) {
     }
     if (arg == "--skip-capacity") {
       o.skip_capacity = true;
+      continue;
+    }
+    if (arg == "--abuse") {
+      o.abuse = true;
       continue;
     }
     if (i + 1 >= argc) throw std::invalid_argument("option " + arg + " needs a value");
@@ -104,6 +133,29 @@ Options parse_options(int argc, char** argv) {
       o.manager = value;
     } else if (arg == "--log") {
       o.log = value;
+    } else if (arg == "--soak") {
+      o.soak = true;
+      o.soak_options.minutes = bench::parse_int(value, 1, 24 * 60, arg);
+    } else if (arg == "--sessions-per-minute") {
+      o.soak_options.sessions_per_minute = bench::parse_int(value, 1, 600, arg);
+    } else if (arg == "--soak-max-sessions") {
+      o.soak_options.max_sessions = bench::parse_int(value, 1, 64, arg);
+    } else if (arg == "--watch-seconds") {
+      o.soak_options.watch_seconds = bench::parse_int(value, 1, 600, arg);
+    } else if (arg == "--abuse-repetitions") {
+      o.abuse_options.repetitions = bench::parse_int(value, 1, 100, arg);
+    } else if (arg == "--abuse-seconds") {
+      o.abuse_options.seconds = bench::parse_int(value, 1, 600, arg);
+    } else if (arg == "--half-open") {
+      o.abuse_options.half_open = bench::parse_int(value, 0, 60000, arg);
+    } else if (arg == "--abuse-from") {
+      in_addr parsed{};
+      if (::inet_pton(AF_INET, value.c_str(), &parsed) != 1) {
+        throw std::invalid_argument(arg + ": '" + value + "' is not an IPv4 address");
+      }
+      o.abuse_options.from = value;
+    } else if (arg == "--storm-per-second") {
+      o.abuse_options.storm_per_second = bench::parse_int(value, 0, 1000, arg);
     } else {
       throw std::invalid_argument("unknown option " + arg);
     }
@@ -128,53 +180,7 @@ double iso_ms(const std::string& text) {
   return static_cast<double>(::timegm(&parts)) * 1000.0 + millis;
 }
 
-bool is_live_state(const std::string& state) { return state == "starting" || state == "running" || state == "ending"; }
-
-// A sim_manager on a free loopback port with its data in `data_dir`, as the benchmark runs it: SIGTERM on
-// destruction, which ends its sessions, and the index polled every 5 ms (table 1 times "admin end -> session
-// gone" by polling it). Its stderr, and its sessions' launch chatter, go to the log.
-ManagerUnderTest start_manager(const Options& options, const std::filesystem::path& data_dir,
-                               const std::vector<std::string>& session_args, int max_sessions) {
-  std::vector<std::string> flags = {"--max-sessions", std::to_string(max_sessions), "--admin-token", kAdminToken,
-                                    "--scenarios", options.scenario, "--max-duration-s", "3600"};
-  for (const std::string& arg : session_args) flags.insert(flags.end(), {"--session-arg", arg});
-  rfbsim::test::ManagerOptions how;
-  how.program = options.manager;
-  how.stop_signal = SIGTERM;
-  how.stop_timeout = milliseconds(30000);
-  how.poll_interval = milliseconds(5);
-  const bench::StderrToFile redirect(options.log);
-  return ManagerUnderTest(data_dir, flags, how);
-}
-
-// GET /start for `uid`; returns the token of the 302's /s/<token>/, throws on any other answer.
-std::string start_session(const ManagerUnderTest& manager, const std::string& uid, const std::string& scenario) {
-  const net::HttpResponse response = manager.start("uid=" + uid + "&scenario=" + scenario);
-  const std::string token = rfbsim::test::token_from_redirect(response);
-  if (token.empty()) {
-    throw std::runtime_error("/start for uid " + uid + " answered " + std::to_string(response.status) + ": " +
-                             response.body.substr(0, 200));
-  }
-  return token;
-}
-
-// POST /api/sessions/<id>/end; throws unless the manager accepted it.
-void end_session(const ManagerUnderTest& manager, std::int64_t id) {
-  const net::HttpResponse response = manager.end_session(id, kAdminToken);
-  if (response.status != 200) {
-    throw std::runtime_error("ending session " + std::to_string(id) + " answered " + std::to_string(response.status) +
-                             ": " + response.body);
-  }
-}
-
-// Polls the index until the session's row satisfies `done`; throws after `timeout`, saying what it never did.
-IndexRow wait_for_row(const ManagerUnderTest& manager, const std::string& token,
-                      const std::function<bool(const IndexRow&)>& done, milliseconds timeout, const char* what) {
-  if (auto row = manager.wait_for_row(token, done, timeout)) return *row;
-  const auto last = manager.row_for_token(token);
-  throw std::runtime_error(std::string("session ") + token + " never " + what + " (state " +
-                           (last ? last->state : "absent") + ")");
-}
+bench::ManagerRun manager_run(const Options& options) { return {options.manager, options.log, options.scenario}; }
 
 // ----------------------------------------------------------------------------------------------------------
 // 1. Link to first frame
@@ -291,9 +297,11 @@ std::vector<RelayRound> run_relay(const Options& options, const ManagerUnderTest
   const std::string token = start_session(manager, uid, options.scenario);
   const IndexRow row = wait_for_row(manager, token, [](const IndexRow& x) { return x.state == "running"; },
                                             kFirstUpdateTimeout, "became ready");
-  const std::string direct_url = "ws://127.0.0.1:" + std::to_string(row.port) + "/";
-  // libvncserver refuses a WebSocket handshake without an Origin header.
-  const std::string direct_origin = "http://127.0.0.1:" + std::to_string(row.port);
+  // Sessions started by the manager take a PROXY line first (--proxy-protocol), as its relay sends: A goes
+  // through a forwarder that sends one, which sim_rfb then trusts instead of checking the Origin.
+  const bench::ProxyLineForwarder forwarder(row.port);
+  const std::string direct_url = "ws://127.0.0.1:" + std::to_string(forwarder.port()) + "/";
+  const std::string direct_origin = "http://127.0.0.1:" + std::to_string(forwarder.port());
 
   // sim_rfb serves its clients newest first, one after the other, encoding each client's update in
   // turn: whichever connected last gets each frame a little earlier. Both orders, so that this cancels.
@@ -374,28 +382,72 @@ void print_summary_row(bench::Table& table, const std::string& stage, const std:
                  bench::fixed(s.mean, 1), bench::fixed(s.max, 1)});
 }
 
+// --soak and --abuse, each against a manager of its own; the soak's limits let one address run it all.
+int run_soak_and_abuse(const Options& options, const std::string& load_at_start) {
+  const auto started = Clock::now();
+  std::printf("bench_manager: CPU %s; load average %s at start; scenario %s; clients: libvncclient (Tight, JPEG) "
+              "behind a WsRfbBridge, all on this machine over loopback\n\n",
+              bench::cpu_description().c_str(), load_at_start.c_str(), options.scenario.c_str());
+  if (options.soak) {
+    const bench::SoakOptions& soak = options.soak_options;
+    const rfbsim::test::TempDir data("rfbsim-bench-manager");  // outlives the manager
+    // Every soak session comes from 127.0.0.1 and many are unseen at once: the per-address limits are off.
+    const ManagerUnderTest manager = bench::start_manager(
+        manager_run(options), data.path(), kSoakSessionArgs, soak.max_sessions,
+        rfbsim::test::without_abuse_limits({"--idle-timeout-s", std::to_string(bench::kSoakIdleTimeoutS)}));
+    std::printf("sim_manager (pid %d) with --max-sessions %d --idle-timeout-s %d --rate-start-per-minute 0 "
+                "--rate-upgrade-per-minute 0 --max-unspent-sessions-per-address 0; sessions --fps 15\n",
+                static_cast<int>(manager.pid()), soak.max_sessions, bench::kSoakIdleTimeoutS);
+    bench::print_soak(bench::run_soak(manager, options.scenario, soak), soak);
+  }
+  if (options.abuse) {
+    // The abuser's sockets and the participant's share this process's descriptors; the manager inherits
+    // the limit (a deployment raises it the same way, e.g. systemd's LimitNOFILE).
+    const long limit = bench::raise_descriptor_limit(options.abuse_options.half_open + 4096L);
+    const rfbsim::test::TempDir data("rfbsim-bench-manager");  // outlives the manager
+    const ManagerUnderTest manager = bench::start_manager(manager_run(options), data.path(), {}, 4);
+    bench::print_abuse(bench::run_abuse(manager, options.scenario, options.abuse_options, limit),
+                       options.abuse_options);
+  }
+  std::printf("sim_manager's stderr: %s; load average %s at the end; total run time %.1f s\n", options.log.c_str(),
+              bench::load_average().c_str(), bench::ms_between(started, Clock::now()) / 1000.0);
+  return 0;
+}
+
 int run(const Options& options) {
   if (!std::filesystem::is_regular_file(options.manager)) {
     throw std::runtime_error("no sim_manager at " + options.manager + " (build it, or pass --manager PATH)");
   }
   std::ofstream(options.log, std::ios::trunc).close();
   const std::string load_at_start = bench::load_average();
+  if (options.soak || options.abuse) return run_soak_and_abuse(options, load_at_start);
   const auto started = Clock::now();
 
   FirstFrameResult first;
   std::vector<RelayRound> relay;
+  std::string relay_error;  // table 2 could not run
   {
     const rfbsim::test::TempDir data("rfbsim-bench-manager");  // outlives the manager
-    const ManagerUnderTest manager = start_manager(options, data.path(), {}, 2);
+    const ManagerUnderTest manager = bench::start_manager(manager_run(options), data.path(), {}, 2);
     first = run_first_frame(options, manager);
-    relay = run_relay(options, manager);
+  }
+  {
+    // Client A needs the session's own TCP port; by default the relay reaches sessions by a unix socket.
+    const rfbsim::test::TempDir data("rfbsim-bench-manager");  // outlives the manager
+    const ManagerUnderTest manager =
+        bench::start_manager(manager_run(options), data.path(), {}, 2, {"--session-socket", "tcp"});
+    try {
+      relay = run_relay(options, manager);
+    } catch (const std::runtime_error& error) {
+      relay_error = error.what();  // say so, and go on with table 3
+    }
   }
   std::vector<CapacityRow> capacity;
   if (!options.skip_capacity) {
     const rfbsim::test::TempDir data("rfbsim-bench-manager");  // outlives the manager
-    const ManagerUnderTest manager = start_manager(options, data.path(),
-                                                   {"--fps", std::to_string(static_cast<int>(kCapacityFps))},
-                                                   options.max_capacity);
+    const ManagerUnderTest manager = bench::start_manager(
+        manager_run(options), data.path(), {"--fps", std::to_string(static_cast<int>(kCapacityFps))},
+        options.max_capacity);
     capacity = run_capacity(options, manager);
   }
 
@@ -419,34 +471,38 @@ int run(const Options& options) {
   std::printf("\nTarget: link to first frame under 500 ms median (SEAN-EP: 18.9 s). Indented rows are parts of the "
               "row above; rows from the index have 1 ms steps.\n\n");
 
-  std::printf("### 2. Relay cost per update (one session, %d s per order after a %lld ms warm-up; ms)\n\n",
-              options.seconds, static_cast<long long>(kRelayWarmUp.count()));
-  bench::Table relay_table({"connected first", "updates A", "updates B", "matched", "bit-identical", "unmatched A",
-                            "unmatched B", "t_B - t_A p50", "p90", "mean"},
-                           1);
-  std::vector<double> pooled;
-  for (const RelayRound& r : relay) {
-    const bench::Summary s = bench::summarize(r.delta_ms);
-    relay_table.add_row({r.first_connected, std::to_string(r.updates_a), std::to_string(r.updates_b),
-                         std::to_string(s.n), std::to_string(r.identical), std::to_string(r.unmatched_a),
-                         std::to_string(r.unmatched_b),
-                         bench::fixed(s.p50, 2), bench::fixed(s.p90, 2), bench::fixed(s.mean, 2)});
-    pooled.insert(pooled.end(), r.delta_ms.begin(), r.delta_ms.end());
+  if (!relay_error.empty()) {
+    std::printf("### 2. Relay cost per update: not measured (%s)\n\n", relay_error.c_str());
+  } else {
+    std::printf("### 2. Relay cost per update (one session, %d s per order after a %lld ms warm-up; ms)\n\n",
+                options.seconds, static_cast<long long>(kRelayWarmUp.count()));
+    bench::Table relay_table({"connected first", "updates A", "updates B", "matched", "bit-identical", "unmatched A",
+                              "unmatched B", "t_B - t_A p50", "p90", "mean"},
+                             1);
+    std::vector<double> pooled;
+    for (const RelayRound& r : relay) {
+      const bench::Summary s = bench::summarize(r.delta_ms);
+      relay_table.add_row({r.first_connected, std::to_string(r.updates_a), std::to_string(r.updates_b),
+                           std::to_string(s.n), std::to_string(r.identical), std::to_string(r.unmatched_a),
+                           std::to_string(r.unmatched_b),
+                           bench::fixed(s.p50, 2), bench::fixed(s.p90, 2), bench::fixed(s.mean, 2)});
+      pooled.insert(pooled.end(), r.delta_ms.begin(), r.delta_ms.end());
+    }
+    const bench::Summary all = bench::summarize(pooled);
+    relay_table.add_row({"both orders pooled", "", "", std::to_string(all.n), "", "", "", bench::fixed(all.p50, 2),
+                         bench::fixed(all.p90, 2), bench::fixed(all.mean, 2)});
+    relay_table.print();
+    double order_neutral = 0.0;
+    for (const RelayRound& r : relay) {
+      order_neutral += bench::summarize(r.delta_ms).p50 / static_cast<double>(relay.size());
+    }
+    std::printf("\nA: WsRfbBridge -> a PROXY-line forwarder -> the session's port (sim_rfb's own WebSocket); B: WsRfbBridge -> "
+                "the manager's /s/<token>/ws -> relay -> the same port.\nsim_rfb encodes and sends each frame to its "
+                "clients one after the other, newest connection first, so the order biases t_B - t_A by about one "
+                "update's encoding time in opposite directions; the mean of the two orders' medians, %.2f ms, estimates "
+                "the relay's cost per update. Target: under 1 ms.\n\n",
+                order_neutral);
   }
-  const bench::Summary all = bench::summarize(pooled);
-  relay_table.add_row({"both orders pooled", "", "", std::to_string(all.n), "", "", "", bench::fixed(all.p50, 2),
-                       bench::fixed(all.p90, 2), bench::fixed(all.mean, 2)});
-  relay_table.print();
-  double order_neutral = 0.0;
-  for (const RelayRound& r : relay) {
-    order_neutral += bench::summarize(r.delta_ms).p50 / static_cast<double>(relay.size());
-  }
-  std::printf("\nA: WsRfbBridge -> ws://127.0.0.1:<session port>/ (sim_rfb's own WebSocket); B: WsRfbBridge -> "
-              "the manager's /s/<token>/ws -> relay -> the same port.\nsim_rfb encodes and sends each frame to its "
-              "clients one after the other, newest connection first, so the order biases t_B - t_A by about one "
-              "update's encoding time in opposite directions; the mean of the two orders' medians, %.2f ms, estimates "
-              "the relay's cost per update. Target: under 1 ms.\n\n",
-              order_neutral);
 
   if (!options.skip_capacity) {
     std::printf("### 3. Capacity at %.0f fps (one client per session through the relay; updates/s over %lld s "

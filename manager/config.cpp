@@ -154,6 +154,7 @@ const std::map<std::string, Setting>& settings() {
       {"max_sessions", {false, integer(&ManagerConfig::max_sessions, 1, 10000)}},
       {"max_duration_s", {false, seconds(&ManagerConfig::max_duration, 1)}},
       {"idle_timeout_s", {false, seconds(&ManagerConfig::idle_timeout, 1)}},
+      {"first_connect_timeout_s", {false, seconds(&ManagerConfig::first_connect_timeout, 1)}},
       {"start_timeout_s", {false, seconds(&ManagerConfig::start_timeout, 1)}},
       {"stop_grace_s", {false, seconds(&ManagerConfig::stop_grace, 0)}},
       {"data_dir", {false, text(&ManagerConfig::data_dir)}},
@@ -301,6 +302,8 @@ std::string manager_usage() {
          "  --max-sessions N        live sessions at once (default 4)\n"
          "  --max-duration-s S      a session ends S seconds after it started (default 300)\n"
          "  --idle-timeout-s S      a session ends after S seconds with no browser connected (default 60)\n"
+         "  --first-connect-timeout-s S   a session no browser ever connected to ends S seconds after /start\n"
+         "                          (default 20; the idle timeout when that is shorter)\n"
          "  --start-timeout-s S     a session not ready after S seconds failed (default 30)\n"
          "  --stop-grace-s S        seconds between SIGTERM and SIGKILL (default 5)\n"
          "  --data-dir DIR          session index and session folders (default ./rfbsim-data)\n"

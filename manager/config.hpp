@@ -74,6 +74,10 @@ struct ManagerConfig {
   int max_sessions = 4;                      ///< live sessions at once; the next participant is told to wait
   std::chrono::seconds max_duration{300};    ///< a session is ended this long after it started (SEAN-EP: 5 min)
   std::chrono::seconds idle_timeout{60};     ///< ended after this long with no browser connected
+  /// A session no browser ever connected to ends this long after /start (if shorter than idle_timeout): a
+  /// participant's page opens its socket within seconds, a link preview never does, and each such session
+  /// would hold a slot.
+  std::chrono::seconds first_connect_timeout{20};
   std::chrono::seconds start_timeout{30};    ///< a session not ready by then failed to start
   std::chrono::seconds stop_grace{5};        ///< SIGTERM, then SIGKILL after this long
   std::string data_dir = "rfbsim-data";      ///< session index (sessions.db) and one folder per session

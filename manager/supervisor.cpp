@@ -99,6 +99,7 @@ struct Supervisor::Runtime {
   std::string ready_text;
   bool bad_stream_logged = false;  // a bad stream line is logged once per session, not every second
   int clients = 0;
+  bool ever_connected = false;  // a participant's browser connected at least once
   SteadyClock::time_point started;
 };
 
@@ -563,12 +564,17 @@ void Supervisor::process_gone(Session& session, int wait_status) {
 void Supervisor::arm_idle_timer(Session& session) {
   const std::int64_t id = session.id;
   Runtime& rt = runtime(id);
-  rt.idle.expires_after(config_.idle_timeout);
-  rt.idle.async_wait([this, id](const boost::system::error_code& ec) {
+  // Until a browser first comes, the shorter wait: a link preview never opens the socket, and each such
+  // session would hold a slot for the whole idle timeout.
+  const bool first = !rt.ever_connected && config_.first_connect_timeout < config_.idle_timeout;
+  const auto wait = first ? config_.first_connect_timeout : config_.idle_timeout;
+  rt.idle.expires_after(wait);
+  rt.idle.async_wait([this, id, first, wait](const boost::system::error_code& ec) {
     Session* s = table_.by_id(id);
     if (ec || s == nullptr || runtime(id).clients > 0) return;
     begin_end(*s, SessionState::kIdle,
-              "no browser connected for " + std::to_string(config_.idle_timeout.count()) + " s");
+              first ? "no browser connected within " + std::to_string(wait.count()) + " s of the start"
+                    : "no browser connected for " + std::to_string(wait.count()) + " s");
   });
 }
 
@@ -577,6 +583,7 @@ void Supervisor::client_connected(std::int64_t id) {
   if (session == nullptr) return;
   Runtime& rt = runtime(id);
   ++rt.clients;
+  rt.ever_connected = true;
   rt.idle.cancel();
 }
 

@@ -109,6 +109,19 @@ TEST_CASE("a session with no browser ends after the idle timeout, and not while 
   }
 }
 
+TEST_CASE("a session no browser ever connected to ends at the first-connect timeout, long before the idle one",
+          "[manager]") {
+  TempDir data;
+  ManagerUnderTest manager(data.path(),
+                           with_small_sessions({"--idle-timeout-s", "600", "--first-connect-timeout-s", "1"}));
+  const std::string token = token_from_redirect(manager.start("uid=preview-1"));
+  REQUIRE(manager.wait_for_state(token, "abandoned", 15s));
+  const auto row = manager.row_for_token(token);
+  REQUIRE(row);
+  CHECK(row->detail == "no browser connected within 1 s of the start");
+  CHECK(manager.start("uid=preview-1").status == 302);  // the participant can still come
+}
+
 TEST_CASE("an administrator ends a session through the API, and only with the token", "[manager]") {
   TempDir data;
   ManagerUnderTest manager(data.path(), with_small_sessions({"--admin-token", kAdminToken}));
