@@ -88,13 +88,18 @@ std::string resolve_web_root(const std::string& requested) {
                            "; build the web target or give --web-root");
 }
 
+// How long the I/O thread's index reads wait for another connection's lock.
+constexpr int kReaderBusyTimeoutMs = 100;
+
 int run(ManagerConfig config) {
   namespace manager = rfbsim::manager;
   const std::string program = resolve_program(config.session_command);
   const std::string web_root = resolve_web_root(config.web_root);
   if (config.host_id.empty()) config.host_id = default_host_id();
   std::filesystem::create_directories(std::filesystem::path(config.data_dir) / "sessions");
-  manager::SessionIndex index((std::filesystem::path(config.data_dir) / "sessions.db").string());
+  // The I/O thread's connection reads only (the writer thread has its own): it waits at most a moment for a
+  // lock, since every relay waits with it; a read that fails is a 503 for one request.
+  manager::SessionIndex index((std::filesystem::path(config.data_dir) / "sessions.db").string(), kReaderBusyTimeoutMs);
 
   // The relays see a vanished browser as an error code, never as a signal.
   std::signal(SIGPIPE, SIG_IGN);

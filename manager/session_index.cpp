@@ -150,7 +150,7 @@ std::optional<WallTime> parse_iso_utc(const std::string& text) {
   return time;
 }
 
-SessionIndex::SessionIndex(const std::string& path) : path_(path) {
+SessionIndex::SessionIndex(const std::string& path, int busy_timeout_ms) : path_(path) {
   if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX,
                       nullptr) != SQLITE_OK) {
     const std::string message = db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory";
@@ -159,8 +159,8 @@ SessionIndex::SessionIndex(const std::string& path) : path_(path) {
     throw std::runtime_error("session index " + path + ": " + message);
   }
   try {
-    // Another reader (a researcher's sqlite3 shell) may hold a lock for a moment: wait rather than fail.
-    sqlite3_busy_timeout(db_, 5000);
+    // Another connection (a researcher's sqlite3 shell) may hold a lock for a moment: wait rather than fail.
+    sqlite3_busy_timeout(db_, busy_timeout_ms);
     exec("PRAGMA journal_mode = WAL");
     exec("PRAGMA synchronous = FULL");
     exec(kSchema);

@@ -19,8 +19,10 @@ namespace rfbsim::manager {
 
 class SessionIndex {
  public:
-  /// Opens (creating if needed) the index at `path`. Throws std::runtime_error naming the file and cause.
-  explicit SessionIndex(const std::string& path);
+  /// Opens (creating if needed) the index at `path`. `busy_timeout_ms`: how long a statement waits for a lock
+  /// another connection holds (a researcher's sqlite3 shell, a checkpoint) before failing. Throws
+  /// std::runtime_error naming the file and cause.
+  explicit SessionIndex(const std::string& path, int busy_timeout_ms = 5000);
   ~SessionIndex();
   SessionIndex(const SessionIndex&) = delete;
   SessionIndex& operator=(const SessionIndex&) = delete;
