@@ -230,14 +230,17 @@ async function main() {
       `keyboard on the view, walks again (${(100 * walkedAgain).toFixed(1)} %); notices: ${notices.join(' | ')}`);
   await page.screenshot({ path: path.join(env.artifacts, 'reconnect_back.png') });
 
-  // 5. Close 4001 ("opened in another window"): the page says so and does not reconnect by itself.
-  const sockets = relay.websockets();
-  check(sockets.length === 1, `expected one WebSocket through the relay, found ${sockets.length}`);
+  // 5. The same link opened in a second tab (straight to the manager, not through the relay): the manager hands
+  // the session to the newer browser and closes this one with 4001 ("opened in another window"); the page says
+  // so and does not reconnect by itself.
   const upgradesAtTakeover = relay.upgrades;
   const attemptsAtTakeover = (await pageState(page)).attempts;
-  sockets[0].injectClose(4001, 'opened in another window');
+  const secondTab = await context.newPage();
+  await secondTab.goto(new URL(`s/${session.token}/`, managerBase).href);
+  await waitForPicture(secondTab, 'T');
   const panel = page.locator('#disconnected');
   await panel.waitFor({ state: 'visible', timeout: 10_000 });
+  await secondTab.close();
   await sleep(QUIET_MS);
   const takenOver = await pageState(page);
   const panelText = (await panel.innerText()).replace(/\s+/g, ' ').trim();
