@@ -27,7 +27,7 @@ StartRequest request(const std::string& scenario) {
 
 TEST_CASE("sim_rfb gets its fixed flags, the scenario, the seed and where to record the session") {
   ManagerConfig config;
-  const LaunchContext context{7, 0, "/data/p01-1"};
+  const LaunchContext context{7, 0, "/data/p01-1", ""};
   CHECK(session_arguments(config, request("lab"), context) ==
         Args{"--port", "0", "--bind", "127.0.0.1", "--rfb-only", "--ready-fd", "3", "--scenario", "lab", "--seed", "7",
              "--proxy-protocol", "--data-dir", "/data/p01-1", "--uid", "p01", "--codec", "auto"});
@@ -44,7 +44,7 @@ TEST_CASE("with a unix socket sim_rfb is told the socket instead of a port and a
 TEST_CASE("sim_rfb gets the configured codec, and only sim_rfb does") {
   ManagerConfig config;
   config.codec = "h264";
-  const LaunchContext context{7, 0, "/data/p01-1"};
+  const LaunchContext context{7, 0, "/data/p01-1", ""};
   const Args args = session_arguments(config, request("lab"), context);
   const auto codec = std::find(args.begin(), args.end(), "--codec");
   REQUIRE(codec != args.end());
@@ -54,12 +54,12 @@ TEST_CASE("sim_rfb gets the configured codec, and only sim_rfb does") {
   // A legacy RFB program gets its own argument list and nothing else.
   config.session_kind = SessionKind::kRfb;
   config.session_args = {"--rfbport", "{port}"};
-  CHECK(session_arguments(config, request("lab"), LaunchContext{7, 5901, "/d"}) == Args{"--rfbport", "5901"});
+  CHECK(session_arguments(config, request("lab"), LaunchContext{7, 5901, "/d", ""}) == Args{"--rfbport", "5901"});
 }
 
 TEST_CASE("sim_rfb gets the link's completion codes, each only when the link has it") {
   ManagerConfig config;
-  const LaunchContext context{7, 0, "/data/p01-1"};
+  const LaunchContext context{7, 0, "/data/p01-1", ""};
   StartRequest r = request("lab");
   r.code_success = "OK-123";
   r.code_timeout = "LATE_9";
@@ -80,7 +80,7 @@ TEST_CASE("sim_rfb gets the configured extra arguments first, then one flag per 
   config.session_args = {"--width", "1280", "--fps=30"};
   StartRequest r = request("lab");
   r.overrides = {{"avatar_start", "1.5,-2,0.25"}, {"robot_goal", "dock"}, {"crowd", "12"}};
-  const LaunchContext context{18446744073709551615ULL, 0, "/data/p01-1"};
+  const LaunchContext context{18446744073709551615ULL, 0, "/data/p01-1", ""};
   CHECK(session_arguments(config, r, context) == Args{"--width",
                                                        "1280",
                                                        "--fps=30",
@@ -117,7 +117,7 @@ TEST_CASE("the manager's flags and the link's come after the config's, so that s
   config.session_args = {"--avatar-start", "door", "--time-limit", "90"};
   StartRequest r = request("lab");
   r.overrides = {{"avatar_start", "1,2,0"}};
-  const Args args = session_arguments(config, r, LaunchContext{7, 0, "/data/p01-1"});
+  const Args args = session_arguments(config, r, LaunchContext{7, 0, "/data/p01-1", ""});
   const auto last_value = [&](const std::string& flag) {
     const auto at = std::find(args.rbegin(), args.rend(), flag);
     REQUIRE(at != args.rend());
@@ -181,7 +181,7 @@ TEST_CASE("an rfb program gets its argument template with the placeholders repla
                          "--scenario", "{scenario}", "{port}{port}", "{unknown}", "plain"};
   StartRequest r = request("warehouse");
   r.overrides = {{"crowd", "3"}};  // overrides are sim_rfb's; an rfb program's template is all it gets
-  const LaunchContext context{42, 5907, "/data/p01-3"};
+  const LaunchContext context{42, 5907, "/data/p01-3", ""};
   CHECK(session_arguments(config, r, context) == Args{"--listen=127.0.0.1:5907", "5907", "--log",
                                                        "/data/p01-3/p01-42.log", "--scenario", "/srv/w.yaml",
                                                        "59075907", "{unknown}", "plain"});
@@ -191,7 +191,7 @@ TEST_CASE("a replaced value is not searched for placeholders again") {
   ManagerConfig config;
   config.session_kind = SessionKind::kRfb;
   config.session_args = {"{data_dir}:{port}"};
-  const LaunchContext context{1, 5900, "/data/{port}"};
+  const LaunchContext context{1, 5900, "/data/{port}", ""};
   CHECK(session_arguments(config, request("lab"), context) == Args{"/data/{port}:5900"});
   // Also a value replaced before the placeholder it contains would be.
   config.scenarios = {"lab=/srv/{uid}-{seed}.yaml"};
