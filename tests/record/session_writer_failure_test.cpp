@@ -13,22 +13,17 @@
 
 #include "record/session_log.hpp"
 #include "record/session_writer.hpp"
+#include "file_text.hpp"
 #include "scratch_dir.hpp"
 #include "small_tmpfs.hpp"
 
 using namespace rfbsim::sim;
 using nlohmann::json;
+using rfbsim::test::file_text;
 using rfbsim::test::ScratchDir;
 using rfbsim::test::SmallTmpfs;
 
 namespace {
-
-std::string file_text(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 World one_person_world() {
   World world;

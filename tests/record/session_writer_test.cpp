@@ -13,20 +13,15 @@
 
 #include "record/digest.hpp"
 #include "record/session_writer.hpp"
+#include "file_text.hpp"
 #include "scratch_dir.hpp"
 
 using namespace rfbsim::sim;
+using rfbsim::test::file_text;
 using rfbsim::test::ScratchDir;
 using nlohmann::json;
 
 namespace {
-
-std::string file_text(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 World tiny_world() {
   World world;
