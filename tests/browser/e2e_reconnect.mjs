@@ -3,8 +3,8 @@
 // (tcp_relay.mjs) that plays the network. Mid-session the relay cuts every connection and refuses new ones for a
 // few seconds, without the session ending: the page must say that it is reconnecting, try again by itself with
 // growing waits, and get the same session's picture back with no click, the keyboard on the view again. Then the
-// relay ends the WebSocket with close code 4001 ("opened in another window"): the page must say so, must not
-// reconnect by itself, and must take the session back when asked. Last, the researcher ends the session: the
+// same link opens in a second tab, and the manager closes the first with code 4001 ("opened in another window"):
+// the page must say so, must not reconnect by itself, and must take the session back when asked. Last, the researcher ends the session: the
 // page must show the ending and stay quiet.
 //
 // Usage: node e2e_reconnect.mjs SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
