@@ -120,8 +120,10 @@ TEST_CASE("500 idle connections: exactly the newest max_pending_connections wait
   // The oldest made room: the survivors are the last ones that came.
   for (int i = kIdleConnections - cap; i < kIdleConnections; ++i) CHECK_FALSE(closed[static_cast<std::size_t>(i)]);
 
+  // None of the idle connections became an RFB client; the real one is served. (Counting clients after
+  // proxied_client_gets_frame raced with the server noticing that its socket had closed.)
+  CHECK(server.client_count() == 0);
   CHECK(proxied_client_gets_frame(server.port()));
-  CHECK(server.client_count() == 1);
 }
 
 TEST_CASE("500 idle connections on a plain port: the connected client keeps getting fresh frames",
