@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Session lives on the I/O thread: processes, readiness, timers, reaping, the index.
+// Session lives on the I/O thread: processes, readiness, timers, reaping, the index (its writes and the
+// processes' starts are queued for threads of their own).
 #include "supervisor.hpp"
 
 #include <netinet/in.h>
@@ -22,6 +23,7 @@
 #include <thread>
 
 #include "launch_plan.hpp"
+#include "process_launcher.hpp"
 #include "session_process.hpp"
 #include "session_views.hpp"
 #include "tokens.hpp"
@@ -117,7 +119,8 @@ Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::s
       metrics_(metrics),
       table_(config.max_sessions),
       child_watch_(std::make_unique<ChildWatch>(io)),
-      writer_(std::make_unique<IndexWriter>(index.path())) {
+      writer_(std::make_unique<IndexWriter>(index.path())),
+      launcher_(std::make_unique<ProcessLauncher>()) {
   if (config_.session_kind == SessionKind::kSimRfb && config_.session_socket == "unix") socket_dir_ = make_socket_dir();
   next_id_ = index_.max_id() + 1;
   for (const auto& [state, count] : index_.count_by_state()) {
@@ -127,7 +130,8 @@ Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::s
 }
 
 Supervisor::~Supervisor() {
-  writer_.reset();  // writes what is queued
+  launcher_.reset();  // starts nothing more
+  writer_.reset();    // writes what is queued
   if (socket_dir_.empty()) return;
   std::error_code ignored;
   std::filesystem::remove_all(socket_dir_, ignored);
@@ -143,19 +147,31 @@ void Supervisor::wait_for_children() {
 
 Supervisor::Runtime& Supervisor::runtime(std::int64_t id) { return *runtimes_.at(id); }
 
-void Supervisor::save(const Session& session) {
+void Supervisor::save(const Session& session, std::function<void(const std::string&)> committed) {
+  queue_write(false, session, std::move(committed));
+}
+
+void Supervisor::insert_row(const Session& session, std::function<void(const std::string&)> committed) {
+  queue_write(true, session, std::move(committed));
+}
+
+void Supervisor::queue_write(bool insert, const Session& session, std::function<void(const std::string&)> committed) {
   // The table (or the caller) has the newest version now; the index gets it in order, off this thread.
   const std::uint64_t sequence = ++write_sequence_;
   unsaved_[session.id] = {sequence, session};
-  writer_->update(session, [this, id = session.id, sequence](const std::string& error) {
-    asio::post(io_, [this, id, sequence, error] {
+  auto done = [this, id = session.id, sequence, committed = std::move(committed)](const std::string& error) {
+    asio::post(io_, [this, id, sequence, error, committed] {
       const auto it = unsaved_.find(id);
-      if (!error.empty()) {
-        std::fprintf(stderr, "[manager] session %lld: %s\n", static_cast<long long>(id), error.c_str());
-      }
       if (it != unsaved_.end() && it->second.first == sequence) unsaved_.erase(it);
+      if (!error.empty()) std::fprintf(stderr, "[manager] session %lld: %s\n", static_cast<long long>(id), error.c_str());
+      if (committed) committed(error);
     });
-  });
+  };
+  if (insert) {
+    writer_->insert(session, std::move(done));
+  } else {
+    writer_->update(session, std::move(done));
+  }
 }
 
 std::optional<Session> Supervisor::latest_for_uid(const std::string& uid) {
@@ -201,7 +217,7 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
   if (live != nullptr && live->state == SessionState::kEnding) {
     outcome.kind = StartOutcome::Kind::kBusy;  // a few seconds from gone: the busy page retries
     reply(outcome);
-      return;
+    return;
   }
   std::optional<SessionState> last;
   if (live == nullptr) {
@@ -256,7 +272,6 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
   session.host_id = config_.host_id;
   session.start_address = address;
   session.created = std::chrono::system_clock::now();
-  const auto started = SteadyClock::now();
   // Ids are handed out here, so that the row can be written off this thread; the participant is redirected
   // only once it is committed (below), so a redirect always points at a recorded session.
   session.id = next_id_++;
@@ -267,9 +282,8 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
                       (std::to_string(session.id) + "-" + session.uid))
                          .string();
   session.data_path = context.data_dir;
-  SpawnedProcess process;
+  LaunchJob job;
   try {
-    std::filesystem::create_directories(context.data_dir);
     if (config_.session_kind == SessionKind::kRfb) {
       context.port = pick_free_port();
       if (context.port == 0) throw std::runtime_error("no free loopback port");
@@ -278,7 +292,8 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
       context.unix_socket = socket_dir_ + "/" + std::to_string(session.id) + ".sock";
       session.unix_socket = context.unix_socket;
     }
-    SpawnSpec spec;
+    job.folder = context.data_dir;
+    SpawnSpec& spec = job.spec;
     spec.program = program_;
     spec.args = session_arguments(config_, request, context);
     spec.working_dir = context.data_dir;
@@ -287,29 +302,22 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
     spec.limits.address_space_bytes = config_.limits.address_space_mb * 1024 * 1024;
     spec.limits.open_files = config_.limits.open_files;
     spec.limits.cpu_seconds = cpu_limit_seconds(config_);
-    process = spawn_session_process(spec);
   } catch (const std::exception& error) {
-    session.state = SessionState::kFailed;
-    session.detail = error.what();
-    session.ended_at = std::chrono::system_clock::now();
-    insert_row(session, nullptr);
-    ++ended_counts_[SessionState::kFailed];
-    log_session(session, std::string("could not start: ") + error.what());
-    metrics_.count_rejection(Rejection::kStartFailed);
-    outcome.message = error.what();
-    reply(outcome);
-      return;
+    fail_start(std::move(session), error.what(), reply);
+    return;
   }
-  session.pid = process.pid;
-  session.process_start = process.start_ticks;
-  metrics_.count_start();
-  log_session(session, "started " + std::string(config_.session_kind == SessionKind::kSimRfb ? "sim_rfb" : "program") +
-                           " as pid " + std::to_string(process.pid) + " in " + session.data_path);
 
+  // The slot is taken from here on, while the process starts on the launcher's thread (pid -1 until then). The
+  // row goes in now, so that every later change is an update of it; if the index cannot take it, the session
+  // cannot be recorded and must not run.
   Session& kept = table_.add(std::move(session));
   auto& rt = *runtimes_.emplace(kept.id, std::make_unique<Runtime>(io_)).first->second;
-  rt.started = started;
+  rt.started = SteadyClock::now();
   const std::int64_t id = kept.id;
+  insert_row(kept, [this, id](const std::string& error) {
+    Session* s = table_.by_id(id);
+    if (!error.empty() && s != nullptr) begin_end(*s, SessionState::kFailed, error);
+  });
 
   rt.expiry.expires_after(config_.max_duration);
   rt.expiry.async_wait([this, id](const boost::system::error_code& ec) {
@@ -325,40 +333,93 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
     begin_end(*s, SessionState::kFailed, "not ready after " + std::to_string(config_.start_timeout.count()) + " s");
   });
   arm_idle_timer(kept);
-  if (process.ready_fd >= 0) {
-    rt.ready_pipe.assign(process.ready_fd);
-    watch_ready_pipe(kept);
-  } else {
-    poll_rfb_port(id);
-  }
-  outcome.kind = StartOutcome::Kind::kStarted;
-  outcome.token = kept.token;
-  // The row, with the process in it; the redirect once it is committed. If the index cannot take it, the
-  // session cannot be recorded and must not run.
-  insert_row(kept, [this, id, outcome, reply = std::move(reply)](const std::string& error) {
-    if (error.empty()) {
-      reply(outcome);
-      return;
-    }
-    if (Session* s = table_.by_id(id)) begin_end(*s, SessionState::kFailed, error);
-    StartOutcome failed;
-    failed.message = error;
-    reply(failed);
+  ++launches_in_flight_;
+  launcher_->launch(std::move(job), [this, id, reply = std::move(reply)](LaunchResult result) mutable {
+    asio::post(io_, [this, id, result = std::move(result), reply = std::move(reply)]() mutable {
+      launched(id, std::move(result), std::move(reply));
+    });
   });
 }
 
-void Supervisor::insert_row(const Session& session, std::function<void(const std::string&)> committed) {
-  const std::uint64_t sequence = ++write_sequence_;
-  unsaved_[session.id] = {sequence, session};
-  writer_->insert(session, [this, id = session.id, sequence, committed = std::move(committed)](
-                               const std::string& error) {
-    asio::post(io_, [this, id, sequence, error, committed] {
-      const auto it = unsaved_.find(id);
-      if (it != unsaved_.end() && it->second.first == sequence) unsaved_.erase(it);
-      if (!error.empty()) std::fprintf(stderr, "[manager] session %lld: %s\n", static_cast<long long>(id), error.c_str());
-      if (committed) committed(error);
-    });
+void Supervisor::fail_start(Session session, const std::string& error, const StartReply& reply) {
+  session.state = SessionState::kFailed;
+  session.detail = error;
+  session.ended_at = std::chrono::system_clock::now();
+  insert_row(session, nullptr);
+  ++ended_counts_[SessionState::kFailed];
+  log_session(session, "could not start: " + error);
+  metrics_.count_rejection(Rejection::kStartFailed);
+  StartOutcome outcome;
+  outcome.message = error;
+  reply(outcome);
+}
+
+void Supervisor::launched(std::int64_t id, LaunchResult result, StartReply reply) {
+  --launches_in_flight_;
+  Session* session = table_.by_id(id);
+  if (session == nullptr) {  // cannot happen: a session leaves the table only once it has a result
+    if (result.process.pid > 0) signal_process_group(result.process.pid, SIGKILL);
+    return;
+  }
+  if (!result.error.empty()) {
+    session->state = SessionState::kFailed;
+    session->detail = result.error;
+    session->ended_at = std::chrono::system_clock::now();
+    save(*session);
+    ++ended_counts_[SessionState::kFailed];
+    log_session(*session, "could not start: " + result.error);
+    metrics_.count_rejection(Rejection::kStartFailed);
+    if (listener_ != nullptr) listener_->session_closing(*session);
+    runtimes_.erase(id);
+    table_.remove(id);
+    StartOutcome failed;
+    failed.message = result.error;
+    reply(failed);
+    reap_children();  // children that exited while this start was in flight were left for now
+    notify_if_all_gone();
+    return;
+  }
+  session->pid = result.process.pid;
+  session->process_start = result.process.start_ticks;
+  metrics_.count_start();
+  log_session(*session, "started " +
+                            std::string(config_.session_kind == SessionKind::kSimRfb ? "sim_rfb" : "program") +
+                            " as pid " + std::to_string(session->pid) + " in " + session->data_path);
+  Runtime& rt = runtime(id);
+  if (result.process.ready_fd >= 0) rt.ready_pipe.assign(result.process.ready_fd);
+  if (session->state == SessionState::kEnding) {
+    // Ended while it started (shutdown, an administrator, the start deadline, the index): the stop timer is
+    // already armed, and now there is a process for it.
+    signal_process_group(session->pid, config_.stop_grace.count() == 0 ? SIGKILL : SIGTERM);
+  } else if (result.process.ready_fd >= 0) {
+    watch_ready_pipe(*session);
+  } else {
+    poll_rfb_port(id);
+  }
+  // The redirect once the row with the process in it is committed (after the first row, the writer keeps order).
+  save(*session, [this, id, token = session->token, reply = std::move(reply)](const std::string& error) {
+    StartOutcome outcome;
+    const Session* s = table_.by_id(id);
+    if (error.empty() && s != nullptr && is_live(s->state) && s->state != SessionState::kEnding) {
+      outcome.kind = StartOutcome::Kind::kStarted;
+      outcome.token = token;
+    } else {
+      outcome.message = error.empty() ? "the session ended as it started" : error;
+      if (Session* live = table_.by_id(id); live != nullptr && !error.empty()) {
+        begin_end(*live, SessionState::kFailed, error);
+      }
+    }
+    reply(outcome);
   });
+  reap_children();  // it may have exited already, its SIGCHLD handled before its pid was known here
+}
+
+void Supervisor::notify_if_all_gone() {
+  if (shutting_down_ && table_.size() == 0 && on_all_gone_) {
+    auto done = std::move(on_all_gone_);
+    on_all_gone_ = nullptr;
+    asio::post(io_, done);
+  }
 }
 
 void Supervisor::watch_ready_pipe(Session& session) {
@@ -507,17 +568,33 @@ void Supervisor::begin_end(Session& session, SessionState end_as, const std::str
 }
 
 void Supervisor::reap_children() {
+  // While a start is in flight, a child may exit before its pid reaches the table: reaping it then would lose
+  // its exit. So only the sessions' own pids are reaped until no start is in flight; then any child at all.
+  std::vector<pid_t> known;
+  for (Session* session : table_.all()) {
+    if (session->pid > 1) known.push_back(session->pid);
+  }
+  for (const pid_t pid : known) reap_if_exited(pid);
+  if (launches_in_flight_ > 0) return;
   for (;;) {
-    // Look before reaping: while the exited leader is a zombie its id cannot be reused, so the SIGKILL to
-    // its group reaches only what the session's program left behind, never a stranger.
     siginfo_t info{};
     if (::waitid(P_ALL, 0, &info, WEXITED | WNOHANG | WNOWAIT) != 0 || info.si_pid == 0) return;
-    const pid_t pid = info.si_pid;
-    signal_process_group(pid, SIGKILL);
-    int status = 0;
-    if (::waitpid(pid, &status, 0) != pid) return;
-    if (Session* session = table_.by_pid(pid)) process_gone(*session, status);
+    if (!reap_if_exited(info.si_pid)) return;
   }
+}
+
+bool Supervisor::reap_if_exited(pid_t pid) {
+  // Look before reaping: while the exited leader is a zombie its id cannot be reused, so the SIGKILL to its
+  // group reaches only what the session's program left behind, never a stranger.
+  siginfo_t info{};
+  if (::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT) != 0 || info.si_pid != pid) {
+    return false;
+  }
+  signal_process_group(pid, SIGKILL);
+  int status = 0;
+  if (::waitpid(pid, &status, 0) != pid) return false;
+  if (Session* session = table_.by_pid(pid)) process_gone(*session, status);
+  return true;
 }
 
 std::string Supervisor::session_log_tail(const Session& session) const {
@@ -554,11 +631,7 @@ void Supervisor::process_gone(Session& session, int wait_status) {
   const std::int64_t id = session.id;
   runtimes_.erase(id);
   table_.remove(id);  // the slot is free from here on
-  if (shutting_down_ && table_.size() == 0 && on_all_gone_) {
-    auto done = std::move(on_all_gone_);
-    on_all_gone_ = nullptr;
-    asio::post(io_, done);
-  }
+  notify_if_all_gone();
 }
 
 void Supervisor::arm_idle_timer(Session& session) {
@@ -616,11 +689,7 @@ void Supervisor::shutdown(std::function<void()> done) {
   shutting_down_ = true;
   on_all_gone_ = std::move(done);
   for (Session* session : table_.all()) begin_end(*session, SessionState::kShutdown, "the manager stopped");
-  if (table_.size() == 0 && on_all_gone_) {
-    auto callback = std::move(on_all_gone_);
-    on_all_gone_ = nullptr;
-    asio::post(io_, callback);
-  }
+  notify_if_all_gone();
 }
 
 std::optional<Session> Supervisor::find(const std::string& token) {

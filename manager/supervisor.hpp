@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The Supervisor runs the sessions' lives on the manager's one I/O thread: it starts processes, learns
-// when they are ready, ends them at expiry, idle timeout, an administrator's word or shutdown (SIGTERM,
+// The Supervisor runs the sessions' lives on the manager's one I/O thread: it starts processes (through the
+// ProcessLauncher's thread, so that a fork never stalls the relays), learns when they are ready, ends them at expiry, idle timeout, an administrator's word or shutdown (SIGTERM,
 // then SIGKILL after the grace period), reaps them, and writes every change to the index before acting
 // on it. All its methods run on the I/O thread.
 #pragma once
@@ -16,6 +16,7 @@
 
 #include "config.hpp"
 #include "index_writer.hpp"
+#include "process_launcher.hpp"
 #include "metrics.hpp"
 #include "session_index.hpp"
 #include "session_table.hpp"
@@ -95,6 +96,13 @@ class Supervisor {
   struct Runtime;
 
   void begin_end(Session& session, SessionState end_as, const std::string& detail);
+  // A start that failed before it had a slot: recorded as failed, and the participant told.
+  void fail_start(Session session, const std::string& error, const StartReply& reply);
+  // The launcher's result for session `id`, back on the I/O thread: the process joins the session, or the
+  // session fails; `reply` answers the /start once the row with the process is committed.
+  void launched(std::int64_t id, LaunchResult result, StartReply reply);
+  // After shutdown(): calls its `done` once the last session has left the table.
+  void notify_if_all_gone();
   void watch_ready_pipe(Session& session);
   // One line from the program's pipe: "ready PORT" while starting, then "outcome completed|timeout".
   // False when the session was failed for it.
@@ -102,13 +110,16 @@ class Supervisor {
   void poll_rfb_port(std::int64_t id);
   void mark_ready(Session& session, int port);
   void reap_children();
+  // Reaps `pid` if it has exited (and ends its session); false if it has not.
+  bool reap_if_exited(pid_t pid);
   void wait_for_children();
   void process_gone(Session& session, int wait_status);
   void arm_idle_timer(Session& session);
-  void save(const Session& session);
-  // Queues a session's first row; `committed` (may be empty) runs on the I/O thread once it is written ("" or
-  // the error).
+  // Queue a session's newest version (save) or its first row (insert_row) for the writer; `committed` (may be
+  // empty) runs on the I/O thread once it is written, with "" or the error.
+  void save(const Session& session, std::function<void(const std::string&)> committed = nullptr);
   void insert_row(const Session& session, std::function<void(const std::string&)> committed);
+  void queue_write(bool insert, const Session& session, std::function<void(const std::string&)> committed);
   // The uid's newest session in the index or among writes still queued.
   std::optional<Session> latest_for_uid(const std::string& uid);
   std::string session_log_tail(const Session& session) const;
@@ -128,6 +139,9 @@ class Supervisor {
   bool shutting_down_ = false;
   std::string socket_dir_;  // private folder (0700) of the sessions' unix sockets; "" = they use TCP ports
   std::unique_ptr<IndexWriter> writer_;  // the index's writes, off this thread
+  // Session starts, off this thread; its thread must outlive the sessions it started (PR_SET_PDEATHSIG).
+  std::unique_ptr<ProcessLauncher> launcher_;
+  int launches_in_flight_ = 0;  // starts queued or running on the launcher, whose pids the table lacks yet
   std::int64_t next_id_ = 1;             // session ids are handed out here, above the index's highest
   // Sessions whose latest version is queued for the writer, by id: (write sequence, that version). Reads of
   // the index look here first, so that they never see an older row than the table did.
