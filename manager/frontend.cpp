@@ -3,8 +3,6 @@
 // Compiled as C++17 (websocketpp 0.8.2 does not build as C++20 with g++ 12).
 #include "frontend.hpp"
 
-#include <sys/resource.h>
-
 #include <algorithm>
 #include <boost/asio/ssl/context.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -15,11 +13,10 @@
 #include <websocketpp/config/asio.hpp>
 #include <websocketpp/server.hpp>
 
-#include "client_address.hpp"
-#include "connection_limits.hpp"
 #include "link_signature.hpp"
 #include "pages.hpp"
 #include "proxy_line.hpp"
+#include "public_intake.hpp"
 #include "query.hpp"
 #include "rate_limiter.hpp"
 #include "relay.hpp"
@@ -46,40 +43,10 @@ constexpr int kAdminRecentSessions = 200;
 // After a session's socket closes, how long to wait for the process's exit to say why, before telling the
 // browser the connection was lost.
 constexpr auto kUpstreamLostGrace = std::chrono::milliseconds(300);
-// After a failed accept (EMFILE: no descriptor left), how long to wait before the next: accepting at once
-// would fail at once again, a busy loop on the I/O thread that every session's relay shares.
-constexpr auto kAcceptPause = std::chrono::milliseconds(100);
-// Descriptors kept free of public connections for the manager itself: the index, logs, and per live session
-// its relays' upstream sockets, its ready pipe and its spawn.
-constexpr std::size_t kReservedDescriptors = 64;
-constexpr std::size_t kDescriptorsPerSession = 8;
 // The close code and reason an earlier browser gets when a newer one of the same session takes over (the page
 // shows it and does not reconnect by itself, or two tabs would take turns).
 constexpr int kTakenOverCode = 4001;
 constexpr const char* kTakenOverReason = "opened in another window";
-// How often a refusal at accept is logged at most: a flood must not become a flood of log lines.
-constexpr auto kRefusalLogInterval = std::chrono::seconds(10);
-
-// Public connections allowed at once: the configured cap, or what the descriptor limit leaves after the
-// manager's own needs.
-std::size_t total_connection_cap(const ManagerConfig& config) {
-  if (config.abuse.connections_total > 0) return static_cast<std::size_t>(config.abuse.connections_total);
-  rlimit limit{};
-  if (::getrlimit(RLIMIT_NOFILE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return 4096;
-  const std::size_t reserved =
-      kReservedDescriptors + kDescriptorsPerSession * static_cast<std::size_t>(config.max_sessions);
-  const auto available = static_cast<std::size_t>(limit.rlim_cur);
-  return available > reserved + 16 ? available - reserved : 16;
-}
-
-std::vector<AddressRange> parse_trusted(const std::vector<std::string>& entries) {
-  std::vector<AddressRange> ranges;
-  for (const std::string& entry : entries) {
-    if (const auto range = parse_address_range(entry)) ranges.push_back(*range);
-  }
-  return ranges;
-}
-
 // websocketpp's close call for a session's notice.
 template <typename Connection>
 void close_with(Connection& connection, SessionState state) {
@@ -124,12 +91,10 @@ class FrontendImpl final : public Frontend, public SessionListener {
         metrics_(metrics),
         web_root_(std::move(web_root)),
         tls_(tls),
-        connection_limits_(static_cast<std::size_t>(config.abuse.connections_per_address), total_connection_cap(config)),
         start_limiter_({static_cast<double>(config.abuse.start_per_minute), static_cast<double>(config.abuse.start_burst)}),
         upgrade_limiter_(
             {static_cast<double>(config.abuse.upgrade_per_minute), static_cast<double>(config.abuse.upgrade_burst)}),
-        trusted_proxies_(parse_trusted(config.trusted_proxies)),
-        accept_pause_(io),
+        intake_(io, server_, config, metrics),
         ping_timer_(io) {
     server_.clear_access_channels(websocketpp::log::alevel::all);
     server_.clear_error_channels(websocketpp::log::elevel::all);
@@ -194,7 +159,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
                                ": " + ec.message());
     }
     listening_ = true;
-    accept_next();
+    intake_.start();
     ping_relays_later();
   }
 
@@ -208,97 +173,11 @@ class FrontendImpl final : public Frontend, public SessionListener {
   void stop() override {
     websocketpp::lib::error_code ec;
     listening_ = false;
-    accept_pause_.cancel();
+    intake_.stop();
     ping_timer_.cancel();
     server_.stop_listening(ec);
     auto relays = relays_;
     for (auto& [hdl, relay] : relays) relay->close(websocketpp::close::status::going_away, "server shutting down");
-  }
-
-  // ------------------------------------------------------------------------------------------------------
-  // Accepting: our own loop instead of websocketpp's, which accepts again at once after an error and so spins
-  // on EMFILE, and knows nothing of per-address caps.
-  // ------------------------------------------------------------------------------------------------------
-  void accept_next() {
-    if (!listening_) return;
-    ConnectionPtr con = server_.get_connection();
-    if (!con) {
-      pause_accepting("cannot make a connection object");
-      return;
-    }
-    websocketpp::lib::error_code ec;
-    server_.async_accept(con, [this, con](const websocketpp::lib::error_code& accept_ec) { accepted(con, accept_ec); },
-                         ec);
-    if (ec) pause_accepting(ec.message());
-  }
-
-  void pause_accepting(const std::string& why) {
-    metrics_.count_accept_error();
-    if (!accept_paused_) {
-      std::fprintf(stderr, "[manager] accepting connections failed (%s); pausing %lld ms between tries\n", why.c_str(),
-                   static_cast<long long>(kAcceptPause.count()));
-    }
-    accept_paused_ = true;
-    accept_pause_.expires_after(kAcceptPause);
-    accept_pause_.async_wait([this](const boost::system::error_code& ec) {
-      if (!ec) accept_next();
-    });
-  }
-
-  void accepted(const ConnectionPtr& con, const websocketpp::lib::error_code& ec) {
-    if (ec) {
-      websocketpp::lib::error_code ignored;
-      con->terminate(ignored);
-      if (ec == websocketpp::error::operation_canceled || !listening_) return;
-      pause_accepting(ec.message());  // EMFILE and the like: the next accept would fail at once too
-      return;
-    }
-    if (accept_paused_) {
-      std::fprintf(stderr, "[manager] accepting connections again\n");
-      accept_paused_ = false;
-    }
-    admit_connection(con);
-    accept_next();
-  }
-
-  // Counts the connection against its address's cap and the total, or closes it at once. A trusted front
-  // end carries many participants on one address: it counts in the total only.
-  void admit_connection(const ConnectionPtr& con) {
-    boost::system::error_code ec;
-    auto& socket = con->get_raw_socket().lowest_layer();
-    const auto remote = socket.remote_endpoint(ec);
-    if (ec) {
-      socket.close(ec);
-      return;
-    }
-    const std::string peer = remote.address().to_string();
-    const auto parsed = parse_address(peer);
-    const bool trusted = parsed && std::any_of(trusted_proxies_.begin(), trusted_proxies_.end(),
-                                               [&](const AddressRange& range) { return range_contains(range, *parsed); });
-    const std::string key = trusted ? std::string("trusted proxy") : (parsed ? address_text(*parsed) : peer);
-    const bool allowed = trusted ? connection_limits_.try_open_uncapped(key) : connection_limits_.try_open(key);
-    if (!allowed) {
-      metrics_.count_rejection(Rejection::kConnectionLimit);
-      const auto now = std::chrono::steady_clock::now();
-      if (now - last_refusal_log_ >= kRefusalLogInterval) {
-        last_refusal_log_ = now;
-        std::fprintf(stderr, "[manager] refused connections over the cap (%zu open, %zu from %s)\n",
-                     connection_limits_.open_total(), connection_limits_.open(key), key.c_str());
-      }
-      socket.close(ec);
-      return;
-    }
-    // Released when websocketpp is done with the connection, whichever way it ends.
-    con->set_termination_handler([this, key](ConnectionPtr) { connection_limits_.closed(key); });
-    con->start();
-  }
-
-  // The address limits and logs use: the peer, or the participant a trusted front end names.
-  std::string client_address_of(const ConnectionPtr& con) {
-    boost::system::error_code ec;
-    const auto remote = con->get_raw_socket().lowest_layer().remote_endpoint(ec);
-    if (ec) return "unknown";
-    return client_address(remote.address().to_string(), con->get_request_header("X-Forwarded-For"), trusted_proxies_);
   }
 
   // A ping to every relay's browser; the pong timeout (set above) closes those that do not answer.
@@ -417,7 +296,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
                                    ",\"capacity\":" + std::to_string(config_.max_sessions) + "}");
         return;
       case RouteKind::kMetrics:
-        metrics_.set_connections(connection_limits_.open_total(), connection_limits_.addresses());
+        metrics_.set_connections(intake_.open_total(), intake_.addresses());
         respond(con, 200,
                 metrics_.render(supervisor_.counts_by_state(), config_.max_sessions, relay_counts(), session_streams()),
                 "text/plain; version=0.0.4; charset=utf-8");
@@ -437,7 +316,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
   }
 
   void handle_start(const ConnectionPtr& con, const Route& route) {
-    const std::string address = client_address_of(con);
+    const std::string address = intake_.client_address_of(con);
     const auto decision = start_limiter_.take(address, std::chrono::steady_clock::now());
     if (!decision.allowed) {
       metrics_.count_rejection(Rejection::kRateLimited);
@@ -646,7 +525,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
   }
 
   bool validate_websocket(const ConnectionPtr& con) {
-    const auto decision = upgrade_limiter_.take(client_address_of(con), std::chrono::steady_clock::now());
+    const auto decision = upgrade_limiter_.take(intake_.client_address_of(con), std::chrono::steady_clock::now());
     if (!decision.allowed) {
       con->replace_header("Retry-After", std::to_string(decision.retry_after.count()));
       return reject_websocket(con, 429, Rejection::kRateLimited, "too many connection attempts; try again later");
@@ -792,15 +671,11 @@ class FrontendImpl final : public Frontend, public SessionListener {
     RelayKind kind = RelayKind::kParticipant;
   };
   std::map<connection_hdl, Pending, std::owner_less<connection_hdl>> pending_;
-  ConnectionLimits connection_limits_;
   RateLimiter start_limiter_;
   RateLimiter upgrade_limiter_;
-  std::vector<AddressRange> trusted_proxies_;
-  asio::steady_timer accept_pause_;
+  PublicIntake<Server> intake_;  // after server_, which it accepts for
   asio::steady_timer ping_timer_;
   bool listening_ = false;
-  bool accept_paused_ = false;
-  std::chrono::steady_clock::time_point last_refusal_log_{};
 };
 
 // TLS settings for the public port: TLS 1.2 and later, the certificate chain and key loaded once, now,
