@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 # Writes the shipped scenarios' ROS map_server maps (PGM + YAML) from wall rectangles, so that the
 # images can be regenerated and reviewed as text. Run from this folder: python3 make_maps.py
-RESOLUTION = 0.05  # m per pixel, as costmaps use (REFERENCE.md)
+RESOLUTION = 0.05  # m per pixel, as costmaps use (docs/sources.md)
 FREE, WALL = 254, 0
 
 

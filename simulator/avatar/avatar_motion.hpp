@@ -14,7 +14,7 @@ struct AvatarParams {
   double backward_speed = 0.7;   ///< m/s backward
   double turn_rate = 1.8;        ///< rad/s
   double acceleration = 6.0;     ///< m/s^2 toward the commanded speed (no instant jumps on the screen)
-  double radius = 0.3;           ///< m, body radius for wall contact
+  double radius = 0.25;          ///< m, body radius for wall contact (as the world's Avatar)
   double stride_length = 1.4;    ///< m per full gait cycle (two steps)
 };
 

@@ -20,7 +20,7 @@ namespace {
 constexpr double kMaxCoordinate = 1.0e4;  // m
 constexpr int kMaxPeople = 500;
 constexpr int kMaxRepeat = 200;
-constexpr double kAvatarClearance = 0.3;  // m, the avatar's body radius
+constexpr double kAvatarClearance = 0.25;  // m, the avatar's body radius (world.hpp, Avatar)
 constexpr double kRobotClearance = 0.16;  // m, Kuri's footprint
 
 std::string known_spawn_names(const Scenario& scenario) {

@@ -102,7 +102,7 @@ TEST_CASE("session.json is complete from the start and gains the outcome, tasks 
   json session = json::parse(file_text(dir / "session.json"));
   CHECK(session["seed"] == "18446744073709551615");
   CHECK(session["parameters"] == json{{"crowd", "1"}});
-  CHECK(session["agents"] == json::parse(R"([{"kind":"avatar","id":0,"radius":0.3},{"kind":"person","id":7,"radius":0.25}])"));
+  CHECK(session["agents"] == json::parse(R"([{"kind":"avatar","id":0,"radius":0.25},{"kind":"person","id":7,"radius":0.25}])"));
   CHECK(session["outcome"].is_null());
   CHECK(session["ended_at"].is_null());
   CHECK(session["codes"] == json{{"success", "A1"}, {"timeout", "B2"}});

@@ -77,6 +77,15 @@ TEST_CASE("the overall and per-scenario tables give the rates and statistics of 
   CHECK(row_of(rows, "a").at("timed_out") == "1");
   CHECK(row_of(rows, "a").at("robot_within_0_45") == "1");
   CHECK(number(row_of(rows, "a"), "min_robot_avatar_distance") == Approx(0.4));
+  // The gap between the bodies, with the radii the sessions recorded (avatar 0.3 m, robot 0.16 m).
+  CHECK(number(row_of(rows, "a"), "avatar_radius") == Approx(0.3));
+  CHECK(number(row_of(rows, "a"), "robot_radius") == Approx(0.16));
+  CHECK(number(row_of(rows, "a"), "min_robot_avatar_gap") == Approx(0.4 - 0.3 - 0.16));
+  CHECK(row_of(rows, "a").at("robot_gap_within_0_45") == "1");
+  CHECK(number(row_of(rows, "b"), "min_robot_avatar_gap") == Approx(1.0 - 0.46));
+  CHECK(row_of(rows, "b").at("robot_gap_within_0_45") == "0");
+  CHECK(row_of(rows, "b").at("robot_gap_within_1_2") == "1");
+  CHECK(row_of(rows, "c").at("robot_gap_within_1_2") == "0");  // 2 m apart: a gap of 1.54 m
   CHECK(row_of(rows, "b").at("never_moved") == "1");
   CHECK(row_of(rows, "b").at("robot_within_1_2") == "1");
   CHECK(row_of(rows, "b").at("robot_within_0_45") == "0");
@@ -96,6 +105,9 @@ TEST_CASE("the overall and per-scenario tables give the rates and statistics of 
   CHECK(number(all, "pct_never_moved") == Approx(25.0));
   CHECK(number(all, "pct_robot_within_0_45") == Approx(25.0));
   CHECK(number(all, "pct_robot_within_1_2") == Approx(50.0));
+  CHECK(number(all, "pct_robot_gap_within_0_45") == Approx(25.0));  // a only: b's gap is 0.54 m
+  CHECK(number(all, "pct_robot_gap_within_1_2") == Approx(50.0));
+  CHECK(number(all, "min_robot_avatar_gap_mean") == Approx((-0.06 + 0.54 + 1.54 + 2.54) / 4));
   CHECK(number(all, "pct_avatar_pushed_robot") == Approx(25.0));
   CHECK(number(all, "robot_path_length_n") == 4);
   CHECK(number(all, "robot_path_length_mean") == Approx((2.0 + 4.0 + 6.0 + 1.0) / 4));
@@ -117,6 +129,8 @@ TEST_CASE("the overall and per-scenario tables give the rates and statistics of 
   // report.md and report.html carry the same groups.
   const std::string md = read_text(out / "report.md");
   CHECK_THAT(md, Catch::Contains("| scenario lab | 3 | 0 | 33.3 |"));
+  // The paper's figures under the groups, in the columns of the rates they compare with.
+  CHECK_THAT(md, Catch::Contains("| SEAN-EP paper | 372 |  | 6.18 |  | 2.15 |  | 52.4 | 84.9 |  |  |  |  |\n"));
   const std::string html = read_text(out / "report.html");
   CHECK_THAT(html, Catch::Contains("<td>scenario warehouse</td>"));
   CHECK_THAT(html, Catch::Contains("<svg"));

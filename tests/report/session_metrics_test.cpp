@@ -231,3 +231,63 @@ TEST_CASE("only the session itself is measured: from the task clock's start to t
   CHECK(*m.time_to_goal == Approx(4.5));
   CHECK(m.duration == Approx(12.0));
 }
+
+TEST_CASE("the closest approach is given centre to centre and as the gap between the bodies' surfaces") {
+  // The robot drives +x at 0.5 m/s along y = 0 past avatars standing beside the line; each case's avatar
+  // stands `offset` m from it, so the closest centre distance is `offset` (at x = 2.5).
+  struct Case {
+    double offset;       // m: the closest centre distance
+    double avatar;       // m: the avatar's radius as session.json records it
+    bool centre_045, centre_12, gap_045, gap_12;
+  };
+  const Case cases[] = {
+      {0.42, 0.25, true, true, true, true},     // touching bodies of 0.25 + 0.16: gap 0.01 m
+      {0.60, 0.25, false, true, true, true},    // gap 0.19 m: within 0.45 m only between surfaces
+      {1.00, 0.25, false, true, false, true},   // gap 0.59 m
+      {1.50, 0.25, false, false, false, true},  // gap 1.09 m
+      {2.00, 0.25, false, false, false, false},
+      {0.46, 0.30, false, true, true, true},    // the old 0.3 m avatar touching: never within 0.45 m of centres
+  };
+  for (const Case& c : cases) {
+    INFO("offset " << c.offset << ", avatar radius " << c.avatar);
+    ScratchDir scratch;
+    SessionSpec spec;
+    spec.samples = 101;  // the robot from x = 0 to x = 5
+    spec.tracks = {standing("avatar", 0, c.avatar, 2.5, c.offset),
+                   {"robot", 0, 0.16, [](double t) { return State{0.5 * t, 0, 0, 0.5, 0}; }}};
+    const SessionMetrics m = measure(scratch, spec);
+    CHECK(m.avatar_radius == c.avatar);
+    REQUIRE(m.robot_radius);
+    CHECK(*m.robot_radius == 0.16);
+    REQUIRE(m.min_robot_avatar_distance);
+    CHECK(*m.min_robot_avatar_distance == Approx(c.offset));
+    REQUIRE(m.min_robot_avatar_gap);
+    CHECK(*m.min_robot_avatar_gap == Approx(c.offset - c.avatar - 0.16));
+    CHECK(m.robot_within_0_45 == c.centre_045);
+    CHECK(m.robot_within_1_2 == c.centre_12);
+    CHECK(m.robot_gap_within_0_45 == c.gap_045);
+    CHECK(m.robot_gap_within_1_2 == c.gap_12);
+  }
+}
+
+TEST_CASE("overlapping bodies give a negative gap, and a session without a robot has neither measure") {
+  ScratchDir scratch;
+  SessionSpec spec;
+  spec.samples = 3;
+  spec.tracks = {standing("avatar", 0, 0.25, 1.0, 1.0), standing("robot", 0, 0.16, 1.4, 1.0)};
+  const SessionMetrics m = measure(scratch, spec);
+  REQUIRE(m.min_robot_avatar_gap);
+  CHECK(*m.min_robot_avatar_gap == Approx(-0.01));
+  CHECK(m.robot_gap_within_0_45);
+
+  ScratchDir alone_dir;
+  SessionSpec alone;
+  alone.samples = 3;
+  alone.tracks = {standing("avatar", 0, 0.25, 1.0, 1.0)};
+  const SessionMetrics a = measure(alone_dir, alone);
+  CHECK(a.avatar_radius == 0.25);
+  CHECK_FALSE(a.robot_radius);
+  CHECK_FALSE(a.min_robot_avatar_gap);
+  CHECK_FALSE(a.robot_gap_within_0_45);
+  CHECK_FALSE(a.robot_gap_within_1_2);
+}

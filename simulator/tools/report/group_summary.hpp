@@ -19,11 +19,25 @@ struct Rate {
   std::string name;     ///< summary.csv's column is pct_<name>
   std::string meaning;  ///< one line for the report
   std::function<bool(const SessionMetrics&)> holds;
+  /// % of sessions the SEAN-EP paper reports for this rate (372 sessions; docs/sources.md); none where
+  /// the paper gives no figure.
+  std::optional<double> paper_percent;
 };
 
 /// The rates, in order: timed_out, completed, never_moved, found_robot, robot_within_0_45,
-/// robot_within_1_2, avatar_pushed_robot, avatar_person_collision.
+/// robot_within_1_2, robot_gap_within_0_45, robot_gap_within_1_2, avatar_pushed_robot,
+/// avatar_person_collision.
 const std::vector<Rate>& summary_rates();
+
+/// Sessions the SEAN-EP paper's rates (Rate::paper_percent) are over (docs/sources.md).
+constexpr int kSeanSessions = 372;
+
+/// What report.md and report.html say under the overview: where the paper's figures come from and which
+/// of our rates compare with them (plain text).
+constexpr const char* kPaperRowNote =
+    "SEAN-EP paper: the figures the study reports over its 372 sessions. It measured the robot's distance to "
+    "the avatar between centres, from ROS logs of poses: compare it with the (centres) rates. The (surfaces) "
+    "rates apply the same thresholds to the gap between the bodies (centre distance minus both radii).";
 
 /// The mean and median of one column over the sessions of a group that have a value for it.
 struct Statistic {

@@ -54,7 +54,12 @@ std::string markdown_report(const ReportData& data) {
     for (const double pct : g.rate_percent) row.push_back(format_fixed(pct, 1));
     rows.push_back(row);
   }
+  // The paper's own figures, for comparison, where it gives one.
+  Row paper = {"SEAN-EP paper", std::to_string(kSeanSessions), ""};
+  for (const Rate& r : summary_rates()) paper.push_back(r.paper_percent ? format_number(*r.paper_percent, 2) : "");
+  rows.push_back(paper);
   table(out, header, rows);
+  out += std::string(kPaperRowNote) + "\n\n";
 
   // Mean and median of each measure, one table per group.
   out += "## Measures (mean and median over the sessions that have a value)\n\n";

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// RobotMetrics: REFERENCE.md's social-navigation measures of the robot over one recorded session, taken at
-// the trajectory's sample rate. The avatar counts as a person throughout.
+// RobotMetrics: the robot's social-navigation measures (docs/sources.md) over one recorded session, taken
+// at the trajectory's sample rate. The avatar counts as a person throughout.
 #pragma once
 
 #include <optional>
@@ -9,7 +9,7 @@
 
 namespace rfbsim::report {
 
-/// The outer edge of Hall's social zone (REFERENCE.md); the inner limits are NavMetrics' ZoneLimits.
+/// The outer edge of Hall's social zone (docs/sources.md); the inner limits are NavMetrics' ZoneLimits.
 constexpr double kSocialZoneLimit = 3.6;  // m
 
 /// The robot's measures over a session's samples. Distances are between body centres.

@@ -60,7 +60,8 @@ void count_events(const sim::SessionLog& log, const Window& window, double from_
   out.avatar_pushed_robot = out.avatar_robot_contacts > 0;
 }
 
-// The avatar's walk and its closest approach to the robot, over the samples.
+// The avatar's walk and its closest approach to the robot, over the samples: centre to centre as the
+// paper's pose logs gave it, and surface to surface with the radii the session recorded.
 void measure_avatar(const SampledSession& samples, SessionMetrics& out) {
   double closest = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < samples.samples.size(); ++i) {
@@ -76,6 +77,10 @@ void measure_avatar(const SampledSession& samples, SessionMetrics& out) {
     out.min_robot_avatar_distance = closest;
     out.robot_within_0_45 = closest < kSeanIntimate;
     out.robot_within_1_2 = closest < kSeanPersonal;
+    const double gap = closest - samples.avatar_radius - samples.robot_radius;
+    out.min_robot_avatar_gap = gap;
+    out.robot_gap_within_0_45 = gap < kSeanIntimate;
+    out.robot_gap_within_1_2 = gap < kSeanPersonal;
   }
 }
 
@@ -111,6 +116,8 @@ SessionMetrics session_metrics(const sim::SessionLog& log, const SampledSession&
   out.timed_out = out.outcome == "timeout";
   out.completed = out.outcome == "completed";
   out.has_robot = samples.has_robot;
+  out.avatar_radius = samples.avatar_radius;
+  if (samples.has_robot) out.robot_radius = samples.robot_radius;
   count_events(log, window, out.measured_from, out);
   measure_avatar(measured, out);
   out.robot = robot_metrics(measured);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // SessionMetrics: everything sim_report says about one session: who and what, the SEAN-EP study's
-// measures of the participant and the robot (REFERENCE.md), and the robot's social-navigation measures.
+// measures of the participant and the robot (docs/sources.md), and the robot's social-navigation measures.
 #pragma once
 
 #include <cstddef>
@@ -14,7 +14,8 @@
 
 namespace rfbsim::report {
 
-/// Distances the SEAN-EP paper counted the robot as "within" the avatar at (centre to centre).
+/// Distances the SEAN-EP paper counted the robot as "within" the avatar at: its figures come from ROS logs
+/// of poses, so centre to centre; sim_report applies them to the surface gap too (docs/sources.md).
 constexpr double kSeanIntimate = 0.45;  // m
 constexpr double kSeanPersonal = 1.2;   // m
 /// An avatar that walked less than this over the whole session never moved.
@@ -56,9 +57,16 @@ struct SessionMetrics {
   bool never_moved = false;  ///< avatar_path_length < 0.1 m
   bool found_robot = false;  ///< a task event: event done, task find_robot
   bool has_robot = false;    ///< session.json lists a robot
+  double avatar_radius = 0.0;                ///< m, the avatar's body radius as session.json records it
+  std::optional<double> robot_radius;        ///< m, the robot's, as session.json records it; none without one
   std::optional<double> min_robot_avatar_distance;  ///< m, centres; none without robot samples
-  bool robot_within_0_45 = false;  ///< min_robot_avatar_distance < 0.45 m
-  bool robot_within_1_2 = false;   ///< min_robot_avatar_distance < 1.2 m
+  bool robot_within_0_45 = false;  ///< min_robot_avatar_distance < 0.45 m (the paper's measure)
+  bool robot_within_1_2 = false;   ///< min_robot_avatar_distance < 1.2 m (the paper's measure)
+  /// m, the closest surfaces came: min_robot_avatar_distance - avatar_radius - robot_radius (negative
+  /// while the bodies overlap); none without robot samples.
+  std::optional<double> min_robot_avatar_gap;
+  bool robot_gap_within_0_45 = false;  ///< min_robot_avatar_gap < 0.45 m
+  bool robot_gap_within_1_2 = false;   ///< min_robot_avatar_gap < 1.2 m
   int avatar_robot_contacts = 0;     ///< contact events between the avatar and the robot
   bool avatar_pushed_robot = false;  ///< avatar_robot_contacts > 0
   int avatar_person_collisions = 0;  ///< contact events between the avatar and a person

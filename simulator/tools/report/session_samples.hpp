@@ -32,8 +32,10 @@ struct Sample {
 struct SampledSession {
   std::vector<Sample> samples;      ///< whole samples only, in tick order
   bool has_robot = false;
-  double avatar_radius = 0.3;       ///< m
-  double robot_radius = 0.16;       ///< m
+  /// m, from session.json (its reader requires a radius for every agent); the defaults are world.hpp's
+  /// (sim::Avatar, sim::Robot) and only hold for a SampledSession built by hand.
+  double avatar_radius = 0.25;
+  double robot_radius = 0.16;       ///< m, as avatar_radius
   std::vector<int> person_ids;      ///< session.json's order
   std::vector<double> person_radii; ///< m, parallel to person_ids
   double sample_interval = 0.1;     ///< s, 1 / trajectory_hz

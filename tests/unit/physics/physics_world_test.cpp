@@ -101,18 +101,18 @@ TEST_CASE("the avatar walking into a wall stops at it and reports one avatar-sta
     events.insert(events.end(), step_events.begin(), step_events.end());
     closest = std::max(closest, w.avatar.pose.x);
   }
-  // The east wall's face is at x = 9; the avatar's radius is 0.3 m.
-  CHECK(closest <= 9.0 - 0.3 + 0.02);
+  // The east wall's face is at x = 9; the avatar's radius is 0.25 m.
+  CHECK(closest <= 9.0 - 0.25 + 0.02);
   // Leaning on the wall it rests in the 5 mm surface layer plus 300 N / 2e5 N/m.
-  CHECK(w.avatar.pose.x == Approx(8.7 + 0.0065).margin(0.001));
+  CHECK(w.avatar.pose.x == Approx(8.75 + 0.0065).margin(0.001));
   CHECK(std::abs(w.avatar.speed) < 0.01);
   REQUIRE(events.size() == 1);
   CHECK(events[0].a == Party::Avatar);
   CHECK(events[0].b == Party::Static);
   CHECK(events[0].impulse > 0.5);
-  // It touched at (9 - 0.3 - 6) / 1.3 s = tick 124 (0-based), give or take the sub-step.
-  CHECK(events[0].tick >= 122);
-  CHECK(events[0].tick <= 125);
+  // It touched at (9 - 0.25 - 6) / 1.3 s = tick 127 (0-based), give or take the sub-step.
+  CHECK(events[0].tick >= 125);
+  CHECK(events[0].tick <= 128);
 
   // Backing off separates it; walking in again is a new touch.
   events = walk(physics, w, 60, -kWalk);
@@ -126,7 +126,7 @@ TEST_CASE("walking diagonally into a wall the avatar slides along it") {
   PhysicsWorld physics(w);
   walk(physics, w, 180, kWalk);
   // It met the east wall after 1.2 m along x; along y it kept the wanted 1.3 * sin 45 deg all the time.
-  CHECK(w.avatar.pose.x == Approx(8.7).margin(0.02));
+  CHECK(w.avatar.pose.x == Approx(8.75).margin(0.02));
   CHECK(w.avatar.pose.y == Approx(1.6 + kWalk * std::sin(std::numbers::pi / 4.0) * 3.0).margin(0.02));
 }
 
@@ -141,7 +141,7 @@ TEST_CASE("the avatar cannot walk through a prop") {
   PhysicsWorld physics(w);
   const auto events = walk(physics, w, 240, kWalk);
   // The crate's face is at x = 5.5.
-  CHECK(w.avatar.pose.x == Approx(5.5 - 0.3).margin(0.02));
+  CHECK(w.avatar.pose.x == Approx(5.5 - 0.25).margin(0.02));
   CHECK(count(events, Party::Avatar, Party::Static) == 1);
 }
 
@@ -161,7 +161,7 @@ TEST_CASE("the avatar cannot walk through a person standing still") {
   CHECK(w.people[0].pose.x - 6.0 < 0.25);
   CHECK(w.people[0].pose.x == Approx(bumped_to).margin(0.001));  // still for the last 2 s
   CHECK(w.people[0].velocity.norm() < 0.01);
-  CHECK(w.people[0].pose.x - w.avatar.pose.x > 0.55 - 0.02);  // the bodies meet at 0.3 + 0.25 m
+  CHECK(w.people[0].pose.x - w.avatar.pose.x > 0.5 - 0.02);  // the bodies meet at 0.25 + 0.25 m
   REQUIRE(count(events, Party::Avatar, Party::Person) == 1);
   CHECK(events[0].a_index == 0);
   CHECK(events[0].b_index == 0);
@@ -180,7 +180,7 @@ TEST_CASE("walking into the standing robot for 3 s pushes it, with one avatar-ro
   }
   INFO("robot x " << w.robot->pose.x << ", avatar x " << w.avatar.pose.x);
   CHECK(w.robot->pose.x - 4.6 > 0.3);
-  CHECK(w.avatar.pose.x < w.robot->pose.x - 0.46 + 0.02);  // pushes, does not pass through
+  CHECK(w.avatar.pose.x < w.robot->pose.x - 0.41 + 0.02);  // pushes, does not pass through
   REQUIRE(count(events, Party::Avatar, Party::Robot) == 1);
   CHECK(events[0].impulse > 0.5);
 }

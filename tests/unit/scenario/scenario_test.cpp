@@ -171,7 +171,7 @@ TEST_CASE("robot.nav overrides the robot's parameters by ROS name") {
   CHECK(p.local_costmap.proxemic.covariance == 0.1);  // one proxemic model for both costmaps
   CHECK(p.global_costmap.inflation.inflation_radius == 0.5);
   CHECK(p.local_costmap.inflation.inflation_radius == 0.45);  // untouched default
-  // Everything else keeps REFERENCE.md's defaults.
+  // Everything else keeps docs/sources.md's defaults.
   CHECK(p.amcl.laser_max_beams == 30);
   CHECK(p.dwa.sim_time == 1.7);
 }

@@ -59,7 +59,7 @@ inline const ObstacleLayer& marks_of(const LayeredCostmap& costmap) {
   return *layer;
 }
 
-// REFERENCE.md's inflation formula with the costmap's parameters.
+// docs/sources.md's inflation formula with the costmap's parameters.
 inline int inflation_expected(double d, const CostmapParams& p) {
   if (d == 0.0) return 254;
   if (d > p.inflation.inflation_radius + 1e-9) return 0;

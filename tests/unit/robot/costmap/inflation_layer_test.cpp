@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The inflation layer: the kernel against REFERENCE.md's formula, a single lethal cell counted per cost
+// The inflation layer: the kernel against docs/sources.md's formula, a single lethal cell counted per cost
 // class (as nav2's inflation test does), nearest-source maxima, clipping to the dirty window, and the
 // static cache against a brute-force nearest-lethal search.
 #include <catch2/catch.hpp>
@@ -16,7 +16,7 @@ namespace {
 constexpr double kRes = 0.05;
 constexpr double kInscribed = 0.16;
 
-// REFERENCE.md's formula, written out again here.
+// docs/sources.md's formula, written out again here.
 int expected_cost(double d, double inflation_radius = 0.3, double w = 3.0) {
   if (d == 0.0) return 254;
   if (d > inflation_radius + 1e-12) return 0;

@@ -26,7 +26,7 @@ SeenPerson person_at(double x, double y, double vx = 0.0, double vy = 0.0) {
   return p;
 }
 
-// REFERENCE.md's formula, written out again here: cov 0.25, amplitude 77, factor 5.
+// docs/sources.md's formula, written out again here: cov 0.25, amplitude 77, factor 5.
 double formula(double x, double y, double sx2, double sy2) {
   return 77.0 * std::exp(-(x * x / (2.0 * sx2) + y * y / (2.0 * sy2)));
 }
