@@ -152,7 +152,10 @@ const std::map<std::string, Setting>& settings() {
          return "";
        }}},
       {"max_sessions", {false, integer(&ManagerConfig::max_sessions, 1, 10000)}},
-      {"max_duration_s", {false, seconds(&ManagerConfig::max_duration, 1)}},
+      {"max_duration_s", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         c.max_duration_set = true;  // the researcher's own limit: fit_max_duration keeps it
+         return seconds(&ManagerConfig::max_duration, 1)(c, v);
+       }}},
       {"idle_timeout_s", {false, seconds(&ManagerConfig::idle_timeout, 1)}},
       {"first_connect_timeout_s", {false, seconds(&ManagerConfig::first_connect_timeout, 1)}},
       {"start_timeout_s", {false, seconds(&ManagerConfig::start_timeout, 1)}},
@@ -300,7 +303,8 @@ std::string manager_usage() {
          "  --session-socket unix|tcp   how the relay reaches a sim_rfb session: a private unix socket (default)\n"
          "                          or a loopback TCP port\n"
          "  --max-sessions N        live sessions at once (default 4)\n"
-         "  --max-duration-s S      a session ends S seconds after it started (default 300)\n"
+         "  --max-duration-s S      a session ends S seconds after /start (default 300, or longer when a\n"
+         "                          scenario's task needs it: its start, time limit and end grace)\n"
          "  --idle-timeout-s S      a session ends after S seconds with no browser connected (default 60)\n"
          "  --first-connect-timeout-s S   a session no browser ever connected to ends S seconds after /start\n"
          "                          (default 20; the idle timeout when that is shorter)\n"
@@ -476,6 +480,52 @@ std::string validate_config(const ManagerConfig& config) {
     return problem;
   }
   return "";
+}
+
+namespace {
+
+// The task's time limit a session of `facts` runs with, s: sim_rfb takes the last --time-limit S of its
+// arguments over the scenario's.
+double task_time_limit(const ManagerConfig& config, const ScenarioFacts& facts) {
+  double limit = facts.time_limit_s;
+  for (std::size_t i = 0; config.session_kind == SessionKind::kSimRfb && i + 1 < config.session_args.size(); ++i) {
+    long long value = 0;
+    if (config.session_args[i] == "--time-limit" && parse_integer(config.session_args[i + 1], 1LL, 86400LL, value)) {
+      limit = static_cast<double>(value);
+    }
+  }
+  return limit;
+}
+
+}  // namespace
+
+std::chrono::seconds session_time_needed(const ManagerConfig& config, const ScenarioFacts& facts) {
+  if (!facts.has_task) return std::chrono::seconds(0);
+  // The latest the clock can start: a first browser is waited for this long after /start, and the relay
+  // reaches sim_rfb once it is ready, which may take until start_timeout.
+  const auto first_browser = std::min(config.first_connect_timeout, config.idle_timeout);
+  const auto clock_start = std::max(config.start_timeout, first_browser);
+  const double seconds = static_cast<double>((clock_start + kSessionEndMargin).count()) +
+                         task_time_limit(config, facts) + facts.end_grace_s;
+  return std::chrono::seconds(static_cast<long long>(std::ceil(seconds - 1e-9)));
+}
+
+std::string fit_max_duration(ManagerConfig& config) {
+  std::string warning;
+  const std::chrono::seconds chosen = config.max_duration;
+  for (const ScenarioFacts& facts : config.scenario_facts) {
+    const std::chrono::seconds needed = session_time_needed(config, facts);
+    if (!config.max_duration_set) {
+      config.max_duration = std::max(config.max_duration, needed);
+    } else if (needed > chosen) {
+      warning += std::string(warning.empty() ? "" : "; ") + "max_duration_s " + std::to_string(chosen.count()) +
+                 " can end a session of " + facts.name + " before its task does (it needs " +
+                 std::to_string(needed.count()) + " s: the start, a time limit of " +
+                 std::to_string(static_cast<long long>(std::ceil(task_time_limit(config, facts)))) + " s and an end grace of " +
+                 std::to_string(static_cast<long long>(std::ceil(facts.end_grace_s))) + " s; docs/deployment.md)";
+    }
+  }
+  return warning;
 }
 
 }  // namespace rfbsim::manager

@@ -8,13 +8,16 @@
 #include <string>
 #include <vector>
 
+#include "start_request.hpp"
+
 namespace rfbsim::manager {
 
 /// How the manager talks to the program it starts for each session.
 enum class SessionKind {
   kSimRfb,  ///< sim_rfb: the manager adds --port 0 --rfb-only --ready-fd 3, --codec and the link's parameters
   kRfb,     ///< any program serving raw RFB on a loopback port: args may use {port} {scenario} {seed} {uid}
-            ///< {data_dir}; ready once the port accepts a connection
+            ///< {data_dir} {t1} {t2} and the overrides' {avatar_start} {avatar_goal} {robot_start}
+            ///< {robot_goal} {crowd} (session_arguments); ready once the port accepts a connection
 };
 
 /// The default RLIMIT_AS of sessions, MiB. AddressSanitizer builds (scripts/test.sh --sanitize) reserve
@@ -72,7 +75,10 @@ struct ManagerConfig {
   /// connect to sessions directly, such as bench_manager's direct path).
   std::string session_socket = "unix";
   int max_sessions = 4;                      ///< live sessions at once; the next participant is told to wait
-  std::chrono::seconds max_duration{300};    ///< a session is ended this long after it started (SEAN-EP: 5 min)
+  /// A session is ended this long after /start (SEAN-EP: 5 min). Unless set, fit_max_duration raises it to
+  /// what the offered scenarios' tasks need.
+  std::chrono::seconds max_duration{300};
+  bool max_duration_set = false;             ///< max_duration_s was given (file or flag): kept as it is
   std::chrono::seconds idle_timeout{60};     ///< ended after this long with no browser connected
   /// A session no browser ever connected to ends this long after /start (if shorter than idle_timeout): a
   /// participant's page opens its socket within seconds, a link preview never does, and each such session
@@ -97,6 +103,9 @@ struct ManagerConfig {
   /// Front ends (nginx, HAProxy) whose X-Forwarded-For names the participant: addresses or CIDR ranges.
   std::vector<std::string> trusted_proxies;
   DataFailurePolicy on_data_incomplete = DataFailurePolicy::kContinue;
+  /// What the offered scenarios' files say (load_scenario_facts, at start-up; kSimRfb only): spawn names for
+  /// /start's checks and task limits for max_duration. Not a setting; empty = nothing known.
+  std::vector<ScenarioFacts> scenario_facts;
 };
 
 /// The outcome of reading settings: a config, or a message naming the file, line or flag at fault.
@@ -117,6 +126,21 @@ ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
 
 /// Checks a finished config for settings that cannot work together; "" when it is fine.
 std::string validate_config(const ManagerConfig& config);
+
+/// The margin after a task's end grace for sim_rfb to write the session's last data and exit by itself.
+inline constexpr std::chrono::seconds kSessionEndMargin{5};
+
+/// How long after /start a session of `facts` may need, whole seconds rounded up: its task's clock starts when
+/// the participant's browser is first served, at the latest when start_timeout or the first-connect timeout
+/// (the idle timeout where that is shorter) runs out, whichever is later; then the time limit (sim_rfb's
+/// --time-limit in session_args if there, else the scenario's), the end grace and kSessionEndMargin. 0 for a
+/// scenario without a task, which never ends by itself.
+std::chrono::seconds session_time_needed(const ManagerConfig& config, const ScenarioFacts& facts);
+
+/// Fits max_duration to config.scenario_facts. Unset (the default), it becomes the longest need if that is
+/// longer than the default, so that no task is cut short; set, it is kept, and the return value warns, naming
+/// each scenario whose task it can cut short and the seconds that one needs ("" when none).
+std::string fit_max_duration(ManagerConfig& config);
 
 /// The --help text.
 std::string manager_usage();

@@ -336,7 +336,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
              "The link's signature is missing or wrong. Please use the exact link your survey gave you.");
       return;
     }
-    const StartParse parsed = parse_start_request(*params, scenario_names(config_.scenarios));
+    const StartParse parsed = parse_start_request(*params, scenario_names(config_.scenarios), config_.scenario_facts);
     if (!parsed.request) {
       refuse(con, 400, Rejection::kBadRequest, "This link is not valid", parsed.error);
       return;

@@ -64,13 +64,21 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
                                            const LaunchContext& context) {
   const std::string scenario = scenario_argument(config.scenarios, request.scenario);
   if (config.session_kind == SessionKind::kRfb) {
-    const std::vector<std::pair<std::string, std::string>> values = {{"{port}", std::to_string(context.port)},
-                                                                      {"{scenario}", scenario},
-                                                                      {"{seed}", std::to_string(context.seed)},
-                                                                      {"{uid}", request.uid},
-                                                                      {"{t1}", request.code_success},
-                                                                      {"{t2}", request.code_timeout},
-                                                                      {"{data_dir}", context.data_dir}};
+    std::vector<std::pair<std::string, std::string>> values = {{"{port}", std::to_string(context.port)},
+                                                                {"{scenario}", scenario},
+                                                                {"{seed}", std::to_string(context.seed)},
+                                                                {"{uid}", request.uid},
+                                                                {"{t1}", request.code_success},
+                                                                {"{t2}", request.code_timeout},
+                                                                {"{data_dir}", context.data_dir}};
+    // The link's overrides too, each as {name} (empty when the link has none): validated like sim_rfb's,
+    // they are the study's conditions, and a program whose template leaves them out never sees them.
+    for (const OverrideParam& param : kOverrideParams) {
+      const auto given = std::find_if(request.overrides.begin(), request.overrides.end(),
+                                      [&param](const auto& override_) { return override_.first == param.name; });
+      values.emplace_back("{" + std::string(param.name) + "}",
+                          given == request.overrides.end() ? std::string() : given->second);
+    }
     std::vector<std::string> args;
     for (const std::string& arg : config.session_args) args.push_back(expand(arg, values));
     return args;

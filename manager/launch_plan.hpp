@@ -30,7 +30,9 @@ struct LaunchContext {
 ///    --codec C (config.codec), --code-success T1 and --code-timeout T2 when the link has them. sim_rfb takes
 ///    the last of a repeated flag, so the manager's and the link's win over the config's (which
 ///    session_args_problem refuses for the manager's flags anyway).
-///  - kRfb: config.session_args with {port}, {scenario}, {seed}, {uid}, {data_dir}, {t1} and {t2} replaced.
+///  - kRfb: config.session_args with {port}, {scenario}, {seed}, {uid}, {data_dir}, {t1}, {t2} and one
+///    placeholder per override, {avatar_start} {avatar_goal} {robot_start} {robot_goal} {crowd}, replaced;
+///    a code or override the link does not have becomes "".
 std::vector<std::string> session_arguments(const ManagerConfig& config, const StartRequest& request,
                                            const LaunchContext& context);
 

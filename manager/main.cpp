@@ -88,6 +88,41 @@ std::string resolve_web_root(const std::string& requested) {
                            "; build the web target or give --web-root");
 }
 
+// Where sim_rfb looks for a scenario given by name (simulator/CMakeLists.txt): the source tree's, then the
+// installed ones. Both come from the build (manager/CMakeLists.txt); without them names are not looked up.
+std::vector<std::filesystem::path> scenario_search_dirs() {
+#if defined(RFBSIM_SOURCE_SCENARIOS) && defined(RFBSIM_INSTALLED_SCENARIOS)
+  return {RFBSIM_SOURCE_SCENARIOS, RFBSIM_INSTALLED_SCENARIOS};
+#else
+  return {};
+#endif
+}
+
+// Reads what the offered scenarios' files say (their spawn names for /start, their tasks' limits for
+// max_duration) into `config`. Throws std::runtime_error for a file that cannot be read or is malformed:
+// every session of it would fail. Warns where a name is not found or an explicit max_duration cuts tasks.
+void learn_scenarios(ManagerConfig& config) {
+  namespace manager = rfbsim::manager;
+  if (config.session_kind != manager::SessionKind::kSimRfb) return;  // a legacy program's scenarios are its own
+  // sim_rfb runs in its session's folder: a FILE relative to where the manager was started must reach it whole.
+  for (std::string& entry : config.scenarios) {
+    const std::size_t eq = entry.find('=');
+    if (eq != std::string::npos && std::filesystem::path(entry.substr(eq + 1)).is_relative()) {
+      entry = entry.substr(0, eq + 1) + std::filesystem::absolute(entry.substr(eq + 1)).string();
+    }
+  }
+  std::string error;
+  std::vector<std::string> missing;
+  config.scenario_facts = manager::load_scenario_facts(config.scenarios, scenario_search_dirs(), error, missing);
+  if (!error.empty()) throw std::runtime_error(error);
+  for (const std::string& entry : missing) {
+    std::fprintf(stderr, "[manager] warning: scenario %s: no file found where sim_rfb looks by name; its links' spawn "
+                 "names are left to sim_rfb and max_duration_s is not fitted to its task\n", entry.c_str());
+  }
+  const std::string warning = manager::fit_max_duration(config);
+  if (!warning.empty()) std::fprintf(stderr, "[manager] warning: %s\n", warning.c_str());
+}
+
 // How long the I/O thread's index reads wait for another connection's lock.
 constexpr int kReaderBusyTimeoutMs = 100;
 
@@ -95,6 +130,7 @@ int run(ManagerConfig config) {
   namespace manager = rfbsim::manager;
   const std::string program = resolve_program(config.session_command);
   const std::string web_root = resolve_web_root(config.web_root);
+  learn_scenarios(config);
   if (config.host_id.empty()) config.host_id = default_host_id();
   std::filesystem::create_directories(std::filesystem::path(config.data_dir) / "sessions");
   // The I/O thread's connection reads only (the writer thread has its own): it waits at most a moment for a

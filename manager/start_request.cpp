@@ -65,6 +65,9 @@ std::optional<std::uint64_t> strict_seed(std::string_view text) {
 // Parameter values are echoed in error pages: cut them short (pages escape them too).
 std::string shown(const std::string& value) { return value.size() > 40 ? value.substr(0, 40) + "..." : value; }
 
+// What a pose override names, if a spawn point: the pose forms are an identifier or x,y,yaw.
+bool names_spawn(const std::string& value) { return is_identifier(value); }
+
 }  // namespace
 
 bool is_identifier(std::string_view text) {
@@ -177,6 +180,33 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
     }
   }
   out.request = std::move(request);
+  return out;
+}
+
+StartParse parse_start_request(const QueryParams& params, const std::vector<std::string>& scenarios,
+                               const std::vector<ScenarioFacts>& facts) {
+  StartParse out = parse_start_request(params, scenarios);
+  if (!out.request) return out;
+  const StartRequest& request = *out.request;
+  const auto known = std::find_if(facts.begin(), facts.end(),
+                                  [&request](const ScenarioFacts& f) { return f.name == request.scenario; });
+  if (known == facts.end()) return out;
+  // sim_rfb would refuse these at start-up, after the participant's slot, process and wait: say it now.
+  for (const auto& [name, value] : request.overrides) {
+    if (name == "crowd") continue;
+    if ((name == "robot_start" || name == "robot_goal") && !known->has_robot) {
+      out.error = name + " is not valid here: scenario " + known->name + " has no robot";
+      out.request.reset();
+      return out;
+    }
+    if (!names_spawn(value) || std::count(known->spawns.begin(), known->spawns.end(), value) > 0) continue;
+    std::string names;
+    for (const std::string& spawn : known->spawns) names += (names.empty() ? "" : ", ") + spawn;
+    out.error = name + " '" + shown(value) + "' is not a spawn point of " + known->name +
+                " (known: " + (names.empty() ? std::string("none") : names) + "; or give x,y,yaw)";
+    out.request.reset();
+    return out;
+  }
   return out;
 }
 

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // The parameters of a /start link, each validated strictly: uid, scenario, seed and the scenario
-// overrides a study may set per participant. Pure: no I/O.
+// overrides a study may set per participant; a spawn point's name is checked against the scenario's own
+// (ScenarioFacts), so that a link naming one it lacks is refused here rather than starting a session that
+// fails. Pure: no I/O.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "query.hpp"
+#include "scenario_facts.hpp"
 
 namespace rfbsim::manager {
 
@@ -53,6 +56,12 @@ bool is_pose(std::string_view text);
 /// Validates the parameters of /start (`sig` is checked elsewhere and ignored here). `scenarios` are the
 /// allowed names; an absent scenario means the first. Unknown parameters are refused.
 StartParse parse_start_request(const QueryParams& params, const std::vector<std::string>& scenarios);
+
+/// As above, then each pose override that names a spawn point must be one of the scenario's (`facts`, found by
+/// name; a scenario without facts is not checked further), and robot_start and robot_goal need a robot:
+/// "avatar_start 'dok' is not a spawn point of warehouse (known: dock, aisle_1, ...)".
+StartParse parse_start_request(const QueryParams& params, const std::vector<std::string>& scenarios,
+                               const std::vector<ScenarioFacts>& facts);
 
 /// The allowed scenario names of a config's list, whose entries are NAME or NAME=FILE.
 std::vector<std::string> scenario_names(const std::vector<std::string>& entries);

@@ -68,6 +68,8 @@ TEST_CASE("every malformed /start parameter gets a 400 that names it, and the ma
       {"uid=aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa", "is not valid"},  // 65
       {"uid=p1&scenario=../../etc/passwd", "is not offered here"},
       {"uid=p1&scenario=office", "is not offered here"},
+      // A spawn name the scenario lacks: refused here, not a session that would fail to start.
+      {"uid=p1&scenario=lab&avatar_start=nowhere", "is not a spawn point of lab"},
       {"uid=p1&seed=-1", "seed '-1' is not valid"},
       {"uid=p1&seed=1e3", "seed '1e3' is not valid"},
       {"uid=p1&seed=18446744073709551616", "is not valid"},

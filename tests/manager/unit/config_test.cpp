@@ -424,3 +424,68 @@ TEST_CASE("sessions get an 8 GiB address-space limit by default, except in Addre
   CHECK(rfbsim::manager::kDefaultAddressSpaceMb == 8192);
 #endif
 }
+
+TEST_CASE("max_duration fits the offered scenarios' tasks unless the config sets it") {
+  using rfbsim::manager::fit_max_duration;
+  using rfbsim::manager::ScenarioFacts;
+  using rfbsim::manager::session_time_needed;
+  ScenarioFacts warehouse;  // SEAN-EP's: a 240 s timer, 15 s to read the code
+  warehouse.name = "warehouse";
+  warehouse.has_task = true;
+  ScenarioFacts long_task = warehouse;
+  long_task.name = "long";
+  long_task.time_limit_s = 600.5;
+  long_task.end_grace_s = 20;
+  ScenarioFacts free_walk;  // no task: nothing ends it but the manager
+  free_walk.name = "free";
+
+  ManagerConfig c;
+  CHECK_FALSE(c.max_duration_set);
+  // The clock starts at the latest when the start timeout (30 s) runs out, later than the first browser's
+  // 20 s; then 240 s, 15 s of grace and 5 s for sim_rfb to write and leave.
+  CHECK(session_time_needed(c, warehouse) == seconds(30 + 240 + 15 + 5));
+  CHECK(session_time_needed(c, long_task) == seconds(30 + 601 + 20 + 5));  // rounded up
+  CHECK(session_time_needed(c, free_walk) == seconds(0));
+  SECTION("the later of the start timeout and the first browser's wait counts") {
+    c.first_connect_timeout = seconds(50);
+    CHECK(session_time_needed(c, warehouse) == seconds(50 + 260));
+    c.idle_timeout = seconds(40);  // the first browser's wait is the idle timeout where that is shorter
+    CHECK(session_time_needed(c, warehouse) == seconds(40 + 260));
+  }
+  SECTION("sim_rfb's --time-limit in session_args wins over the scenario's, the last one given") {
+    c.session_args = {"--time-limit", "100", "--fps", "15", "--time-limit", "60"};
+    CHECK(session_time_needed(c, warehouse) == seconds(30 + 60 + 15 + 5));
+    c.session_args = {"--time-limit", "1.5"};  // sim_rfb refuses it; the scenario's is what is known
+    CHECK(session_time_needed(c, warehouse) == seconds(290));
+  }
+  SECTION("the default fits the shipped scenarios as it is, and grows for a longer task") {
+    c.scenario_facts = {warehouse, free_walk};
+    CHECK(fit_max_duration(c).empty());
+    CHECK(c.max_duration == seconds(300));  // SEAN-EP's 5 min still covers 290 s
+    c.scenario_facts = {warehouse, long_task, free_walk};
+    CHECK(fit_max_duration(c).empty());
+    CHECK(c.max_duration == seconds(656));
+  }
+  SECTION("a max_duration the config sets is kept, with a warning for each task it can cut short") {
+    const ConfigOutcome parsed = parse_manager_args({"--max-duration-s", "280"});
+    REQUIRE(parsed.error.empty());
+    c = parsed.config;
+    CHECK(c.max_duration_set);
+    c.scenario_facts = {warehouse, long_task, free_walk};
+    CHECK(fit_max_duration(c) ==
+          "max_duration_s 280 can end a session of warehouse before its task does (it needs 290 s: the start, a time "
+          "limit of 240 s and an end grace of 15 s; docs/deployment.md); max_duration_s 280 can end a session of long "
+          "before its task does (it needs 656 s: the start, a time limit of 601 s and an end grace of 20 s; "
+          "docs/deployment.md)");
+    CHECK(c.max_duration == seconds(280));
+    c.max_duration = seconds(700);
+    CHECK(fit_max_duration(c).empty());
+  }
+  SECTION("max_duration_s in a config file counts as set too") {
+    ScratchDir dir;
+    const ConfigOutcome loaded = load_config_file(dir.write("manager.yaml", "max_duration_s: 300\n"), ManagerConfig{});
+    REQUIRE(loaded.error.empty());
+    CHECK(loaded.config.max_duration_set);
+    CHECK_FALSE(load_config_file(dir.write("other.yaml", "max_sessions: 2\n"), ManagerConfig{}).config.max_duration_set);
+  }
+}

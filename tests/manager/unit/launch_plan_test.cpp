@@ -180,11 +180,31 @@ TEST_CASE("an rfb program gets its argument template with the placeholders repla
   config.session_args = {"--listen=127.0.0.1:{port}", "{port}", "--log", "{data_dir}/{uid}-{seed}.log",
                          "--scenario", "{scenario}", "{port}{port}", "{unknown}", "plain"};
   StartRequest r = request("warehouse");
-  r.overrides = {{"crowd", "3"}};  // overrides are sim_rfb's; an rfb program's template is all it gets
+  r.overrides = {{"crowd", "3"}};  // an override the template does not name is not added to it
   const LaunchContext context{42, 5907, "/data/p01-3", ""};
   CHECK(session_arguments(config, r, context) == Args{"--listen=127.0.0.1:5907", "5907", "--log",
                                                        "/data/p01-3/p01-42.log", "--scenario", "/srv/w.yaml",
                                                        "59075907", "{unknown}", "plain"});
+}
+
+TEST_CASE("an rfb program gets the link's validated overrides and codes through their placeholders") {
+  ManagerConfig config;
+  config.session_kind = SessionKind::kRfb;
+  config.session_args = {"--port={port}",         "--start",        "{avatar_start}", "--goal={avatar_goal}",
+                         "--robot={robot_start}", "{robot_goal}",   "--people",       "{crowd}",
+                         "--ok",                  "{t1}",           "--late={t2}"};
+  StartRequest r = request("lab");
+  r.overrides = {{"avatar_start", "1.5,-2,0.25"}, {"avatar_goal", "door"}, {"robot_start", "dock"},
+                 {"robot_goal", "0,0,0"},         {"crowd", "12"}};
+  r.code_success = "C1A2B3";
+  r.code_timeout = "T-9_x";
+  const LaunchContext context{1, 5900, "/data/p01-1", ""};
+  CHECK(session_arguments(config, r, context) == Args{"--port=5900", "--start", "1.5,-2,0.25", "--goal=door",
+                                                       "--robot=dock", "0,0,0", "--people", "12", "--ok", "C1A2B3",
+                                                       "--late=T-9_x"});
+  // What the link does not carry is empty: the template decides how its program takes that.
+  CHECK(session_arguments(config, request("lab"), context) ==
+        Args{"--port=5900", "--start", "", "--goal=", "--robot=", "", "--people", "", "--ok", "", "--late="});
 }
 
 TEST_CASE("a replaced value is not searched for placeholders again") {

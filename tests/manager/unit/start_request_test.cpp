@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include <catch2/catch.hpp>
 
+#include "scratch_dir.hpp"
 #include "start_request.hpp"
 
 using rfbsim::manager::is_identifier;
@@ -307,4 +308,159 @@ TEST_CASE("a crowd size is digits only: no sign, not even on zero") {
   CHECK_FALSE(accepted("crowd", "-0"));
   CHECK_FALSE(accepted("crowd", "+1"));
   CHECK_FALSE(accepted("crowd", "501"));
+}
+
+// --- The offered scenarios' facts, and links checked against them ---
+
+namespace {
+
+using rfbsim::manager::load_scenario_facts;
+using rfbsim::manager::parse_scenario_facts;
+using rfbsim::manager::ScenarioFacts;
+
+// A scenario as the warehouse writes one, cut to the keys the manager reads (the rest is sim_rfb's).
+constexpr const char* kDepotYaml = R"(name: depot
+map: maps/depot.yaml
+spawns:
+  dock:   [10.0, 2.8, 1.5708]
+  aisle_1: [4.75, 13.5, 1.5708]
+  office: [3.5, 29.3, -1.5708]
+robot:
+  start: office
+task:
+  time_limit: 240
+  end_grace: 15
+  steps: [{type: reach}]
+)";
+
+ScenarioFacts depot_facts() {
+  std::string error;
+  auto facts = parse_scenario_facts(kDepotYaml, "depot", "depot.yaml", error);
+  REQUIRE(facts);
+  return *facts;
+}
+
+std::string facts_error(const std::string& yaml) {
+  std::string error;
+  CHECK_FALSE(parse_scenario_facts(yaml, "s", "/srv/s.yaml", error));
+  return error;
+}
+
+}  // namespace
+
+TEST_CASE("a scenario file gives its spawn names, whether it has a robot, and its task's limits") {
+  const ScenarioFacts facts = depot_facts();
+  CHECK(facts.name == "depot");
+  CHECK(facts.file == "depot.yaml");
+  CHECK(facts.spawns == std::vector<std::string>{"dock", "aisle_1", "office"});  // in file order
+  CHECK(facts.has_robot);
+  CHECK(facts.has_task);
+  CHECK(facts.time_limit_s == 240.0);
+  CHECK(facts.end_grace_s == 15.0);
+
+  // Without those keys: no spawns, no robot, no task; a task without limits has sim_rfb's defaults.
+  std::string error;
+  const auto bare = parse_scenario_facts("name: bare\nmap: m.yaml\n", "bare", "bare.yaml", error);
+  REQUIRE(bare);
+  CHECK(bare->spawns.empty());
+  CHECK_FALSE(bare->has_robot);
+  CHECK_FALSE(bare->has_task);
+  const auto plain_task = parse_scenario_facts("task:\n  steps: [{type: reach}]\n", "t", "t.yaml", error);
+  REQUIRE(plain_task);
+  CHECK(plain_task->has_task);
+  CHECK(plain_task->time_limit_s == 240.0);
+  CHECK(plain_task->end_grace_s == 15.0);
+  const auto tutorial = parse_scenario_facts("task:\n  time_limit: 180.5\n  end_grace: 0\n", "t", "t.yaml", error);
+  REQUIRE(tutorial);
+  CHECK(tutorial->time_limit_s == 180.5);
+  CHECK(tutorial->end_grace_s == 0.0);
+}
+
+TEST_CASE("a malformed scenario file is an error naming the file, the line and the key") {
+  CHECK(facts_error("task:\n  time_limit: soon\n") == "/srv/s.yaml:2: task.time_limit: expected seconds 1..86400");
+  CHECK(facts_error("task:\n  time_limit: 0\n") == "/srv/s.yaml:2: task.time_limit: expected seconds 1..86400");
+  CHECK(facts_error("task:\n  time_limit: 86401\n") == "/srv/s.yaml:2: task.time_limit: expected seconds 1..86400");
+  CHECK(facts_error("task:\n  end_grace: -1\n") == "/srv/s.yaml:2: task.end_grace: expected seconds 0..3600");
+  CHECK(facts_error("task:\n  end_grace: [1]\n") == "/srv/s.yaml:2: task.end_grace: expected seconds 0..3600");
+  CHECK(facts_error("task: 240\n") == "/srv/s.yaml:1: task: expected a mapping (time_limit, end_grace, steps)");
+  CHECK(facts_error("name: x\nspawns: [a, b]\n") == "/srv/s.yaml:2: spawns: expected a mapping of names to poses");
+  CHECK(facts_error("spawns:\n  a b: [1, 2]\n") ==
+        "/srv/s.yaml:2: spawns: expected a name (letters, digits, - and _, at most 64)");
+  CHECK(facts_error("- a\n- b\n") == "/srv/s.yaml: expected a mapping of scenario keys");
+  CHECK(facts_error("") == "/srv/s.yaml: expected a mapping of scenario keys");
+  CHECK_THAT(facts_error("spawns: {a: [1, 2]\n"), Catch::StartsWith("/srv/s.yaml:"));  // not YAML at all
+}
+
+TEST_CASE("the offered scenarios' files are found as sim_rfb finds them, and a named file must be readable") {
+  rfbsim::test::ScratchDir first;
+  rfbsim::test::ScratchDir second;
+  first.write("depot.yaml", kDepotYaml);
+  second.write("depot.yaml", "spawns: {elsewhere: [1, 1, 0]}\n");  // found second: not read
+  second.write("yard.yaml", "spawns: {gate: [1, 1, 0]}\n");
+  const std::string own = second.write("mine.yaml", "task: {time_limit: 60, steps: [{type: reach}]}\n");
+  std::string error;
+  std::vector<std::string> missing;
+  const auto facts = load_scenario_facts({"depot", "yard", "ghost", "custom=" + own},
+                                         {first.path(), second.path()}, error, missing);
+  CHECK(error.empty());
+  CHECK(missing == std::vector<std::string>{"ghost"});  // not found by name: left to sim_rfb, with a warning
+  REQUIRE(facts.size() == 3);
+  CHECK(facts[0].name == "depot");
+  CHECK(facts[0].spawns == std::vector<std::string>{"dock", "aisle_1", "office"});
+  CHECK(facts[0].file == (first.path() / "depot.yaml").string());
+  CHECK(facts[1].name == "yard");
+  CHECK(facts[1].spawns == std::vector<std::string>{"gate"});
+  CHECK(facts[2].name == "custom");
+  CHECK(facts[2].time_limit_s == 60.0);
+
+  // A file the config names must be there; a malformed one stops the list with its error.
+  missing.clear();
+  load_scenario_facts({"depot", "custom=" + (second.path() / "nope.yaml").string()}, {first.path()}, error, missing);
+  CHECK(error == "scenarios: custom=" + (second.path() / "nope.yaml").string() + ": cannot read " +
+                     (second.path() / "nope.yaml").string());
+  error.clear();
+  load_scenario_facts({"custom=" + second.path().string()}, {}, error, missing);  // a folder is no file
+  CHECK_THAT(error, Catch::StartsWith("scenarios: custom=" + second.path().string() + ": cannot read"));
+  error.clear();
+  const std::string broken = second.write("broken.yaml", "task: {time_limit: never}\n");
+  load_scenario_facts({"broken=" + broken}, {}, error, missing);
+  CHECK(error == broken + ":1: task.time_limit: expected seconds 1..86400");
+}
+
+TEST_CASE("a link naming a spawn point its scenario lacks is refused, before any session starts") {
+  const std::vector<ScenarioFacts> facts = {depot_facts()};
+  const std::vector<std::string> names = {"depot", "lab"};
+  const auto parse = [&](const QueryParams& params) { return parse_start_request(params, names, facts); };
+
+  const StartParse good = parse({{"uid", "p01"}, {"scenario", "depot"}, {"avatar_start", "dock"},
+                                 {"avatar_goal", "office"}, {"robot_start", "aisle_1"}, {"robot_goal", "1.5,2,0"},
+                                 {"crowd", "3"}});
+  REQUIRE(good.request);
+  CHECK(good.request->overrides.size() == 5);
+
+  for (const char* param : {"avatar_start", "avatar_goal", "robot_start", "robot_goal"}) {
+    const StartParse bad = parse({{"uid", "p01"}, {"scenario", "depot"}, {param, "dok"}});
+    CHECK_FALSE(bad.request);
+    CHECK(bad.error == std::string(param) +
+                           " 'dok' is not a spawn point of depot (known: dock, aisle_1, office; or give x,y,yaw)");
+  }
+  // The default scenario is the first offered; its spawns are checked alike.
+  CHECK(parse({{"uid", "p01"}, {"avatar_start", "aisle_9"}}).error ==
+        "avatar_start 'aisle_9' is not a spawn point of depot (known: dock, aisle_1, office; or give x,y,yaw)");
+  // A scenario without facts (not found by name) is checked for form only, as before.
+  CHECK(parse({{"uid", "p01"}, {"scenario", "lab"}, {"avatar_start", "anything"}}).request);
+  // The form is checked first, with its own message.
+  CHECK(parse({{"uid", "p01"}, {"avatar_start", "1,2"}}).error ==
+        "avatar_start '1,2' is not valid: use a spawn point's name or x,y,yaw in metres and radians");
+
+  // A scenario without spawns or without a robot says so.
+  std::string error;
+  const auto bare = parse_scenario_facts("task: {steps: [{type: reach}]}\n", "bare", "bare.yaml", error);
+  REQUIRE(bare);
+  const std::vector<ScenarioFacts> bare_facts = {*bare};
+  CHECK(parse_start_request({{"uid", "p01"}, {"avatar_start", "dock"}}, {"bare"}, bare_facts).error ==
+        "avatar_start 'dock' is not a spawn point of bare (known: none; or give x,y,yaw)");
+  CHECK(parse_start_request({{"uid", "p01"}, {"robot_goal", "1,2,0"}}, {"bare"}, bare_facts).error ==
+        "robot_goal is not valid here: scenario bare has no robot");
+  CHECK(parse_start_request({{"uid", "p01"}, {"avatar_start", "1,2,0"}}, {"bare"}, bare_facts).request);
 }
