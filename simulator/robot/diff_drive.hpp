@@ -8,7 +8,7 @@
 
 namespace rfbsim::sim {
 
-/// Physical limits of a Kuri-like base (REFERENCE.md, SEAN's Kuri). The navigator's own limits (DWA's
+/// Physical limits of a Kuri-like base (docs/sources.md, SEAN's Kuri). The navigator's own limits (DWA's
 /// max_vel_x, SEAN-EP ran 0.3 m/s) are tighter; these bound whatever anything asks of the wheels.
 struct DriveLimits {
   double max_vel_x = 0.5;        ///< m/s forward (Kuri)

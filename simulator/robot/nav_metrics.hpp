@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// NavMetrics: the social-navigation measures of one robot run (REFERENCE.md, Social navigation metrics),
+// NavMetrics: the social-navigation measures of one robot run (docs/sources.md, Social navigation metrics),
 // accumulated tick by tick from the world: path length, closest approach to people, time in Hall's zones,
 // and collisions split by who moved into whom. Used by the tests, bench_nav and (later) session reports.
 #pragma once
@@ -20,7 +20,7 @@ struct ZoneLimits {
   double still_speed = 0.01;    ///< m/s: slower counts as not moving
 };
 
-/// The measures of one run (REFERENCE.md, Social navigation metrics).
+/// The measures of one run (docs/sources.md, Social navigation metrics).
 struct NavSummary {
   double duration = 0.0;            ///< s observed
   double path_length = 0.0;         ///< m the robot travelled

@@ -75,7 +75,7 @@ void Navigator::cancel() {
 }
 
 NavCommand Navigator::cycle(double now, const Pose2& pose, double v, double w, const CostmapGrid& global,
-                            const CostmapGrid& local, bool goal_occupied) {
+                            const CostmapGrid& local, std::optional<Eigen::Vector2d> goal_person) {
   if (!goal_ || state_ == RobotState::Idle || state_ == RobotState::Arrived || state_ == RobotState::Failed) {
     trajectory_.clear();
     return {};
@@ -89,14 +89,17 @@ NavCommand Navigator::cycle(double now, const Pose2& pose, double v, double w, c
   if (state_ == RobotState::Recovering) return recover(now, pose, w, local);
   track_progress(now, pose);
 
-  // Goal check first: within tolerance (and facing the goal's heading, when it has one), or as close as
-  // the person standing on it lets the robot come.
+  // Goal check first: within tolerance (and facing the goal's heading, when it has one), or at social
+  // distance from the person standing at it.
   const Eigen::Vector2d to_goal(goal_->x - pose.x, goal_->y - pose.y);
   const double distance = to_goal.norm();
-  if (goal_reached(pose, goal_occupied)) {
+  if (goal_reached(pose, goal_person)) {
     path_.clear();
     trajectory_.clear();
-    enter(RobotState::Arrived, fixed(distance) + " m from the goal");
+    const double from_person = goal_person ? (*goal_person - Eigen::Vector2d(pose.x, pose.y)).norm() : 0.0;
+    enter(RobotState::Arrived, goal_person && from_person <= params_.person_goal_distance
+                                   ? fixed(from_person) + " m from the person at the goal"
+                                   : fixed(distance) + " m from the goal");
     return {};
   }
   // Not getting anywhere (dithering, waiting behind someone who does not move, or failing to face the
@@ -183,15 +186,30 @@ std::optional<double> Navigator::path_bearing(const Pose2& pose) const {
   return std::atan2(ahead->y() - pose.y, ahead->x() - pose.x);
 }
 
-bool Navigator::goal_reached(const Pose2& pose, bool goal_occupied) const {
+bool Navigator::goal_reached(const Pose2& pose, const std::optional<Eigen::Vector2d>& goal_person) const {
   const double distance = std::hypot(goal_->x - pose.x, goal_->y - pose.y);
   const bool heading_free = params_.yaw_goal_tolerance >= std::numbers::pi;
   if (distance <= params_.xy_goal_tolerance &&
       (heading_free || std::abs(angle_between(pose.yaw, goal_->yaw)) <= params_.yaw_goal_tolerance)) {
     return true;
   }
-  // Someone stands on the goal: as near as they let the robot come is arrived.
-  return goal_occupied && distance <= params_.xy_goal_tolerance + params_.occupied_goal_margin;
+  // The goal is a person: social distance from them is arrived (whatever the heading: they are the goal).
+  return goal_person && (*goal_person - Eigen::Vector2d(pose.x, pose.y)).norm() <= params_.person_goal_distance;
+}
+
+std::optional<Eigen::Vector2d> goal_person_at(const Pose2& goal, std::span<const SeenPerson> people,
+                                              const NavigatorParams& params) {
+  std::optional<Eigen::Vector2d> found;
+  double nearest = params.person_goal_distance;
+  for (const SeenPerson& person : people) {
+    if (!person.position.allFinite() || !(person.velocity.norm() < params.person_goal_standing_speed)) continue;
+    const double d = (person.position - Eigen::Vector2d(goal.x, goal.y)).norm();
+    if (d <= nearest) {
+      nearest = d;
+      found = person.position;
+    }
+  }
+  return found;
 }
 
 bool Navigator::replan(double now, const Pose2& pose, const CostmapGrid& global) {

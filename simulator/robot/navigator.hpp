@@ -48,6 +48,11 @@ struct NavCommand {
 std::optional<Eigen::Vector2d> point_ahead(const std::vector<Eigen::Vector2d>& path, const Eigen::Vector2d& from,
                                            double distance);
 
+/// The person the robot's goal is: of `people`, the one nearest `goal` among those standing (slower than
+/// params.person_goal_standing_speed) within params.person_goal_distance of it; none if nobody is.
+std::optional<Eigen::Vector2d> goal_person_at(const Pose2& goal, std::span<const SeenPerson> people,
+                                              const NavigatorParams& params);
+
 /// move_base for one goal at a time: plan, control, goal check, recoveries (see the top of this file).
 class Navigator {
  public:
@@ -62,9 +67,10 @@ class Navigator {
   void cancel();
 
   /// One control cycle at time `now` (s) from the estimated pose and the drive's current (v, w).
-  /// `goal_occupied`: someone the robot sees stands on the goal, so it can only come near it.
+  /// `goal_person`: where the person standing at the goal is (m; goal_person_at picks them), if anyone is:
+  /// the robot then arrives person_goal_distance from them.
   NavCommand cycle(double now, const Pose2& pose, double v, double w, const CostmapGrid& global,
-                   const CostmapGrid& local, bool goal_occupied = false);
+                   const CostmapGrid& local, std::optional<Eigen::Vector2d> goal_person = std::nullopt);
 
   [[nodiscard]] RobotState state() const { return state_; }
   [[nodiscard]] const std::string& detail() const { return detail_; }
@@ -83,7 +89,7 @@ class Navigator {
   void start_recovery(double now, const Pose2& pose, std::string trigger);
   NavCommand recover(double now, const Pose2& pose, double w, const CostmapGrid& local);
   bool replan(double now, const Pose2& pose, const CostmapGrid& global);
-  bool goal_reached(const Pose2& pose, bool goal_occupied) const;
+  bool goal_reached(const Pose2& pose, const std::optional<Eigen::Vector2d>& goal_person) const;
   /// World direction from the robot to the path point rotate_lookahead on from the nearest one (the path's
   /// last point when it ends nearer); none without a path of two points or more.
   std::optional<double> path_bearing(const Pose2& pose) const;

@@ -23,9 +23,13 @@ struct NavigatorParams {
   bool recovery_behavior_enabled = true;
   double conservative_reset_dist = 3.0;  ///< m: first recovery forgets obstacles farther than this
   double aggressive_reset_dist = 0.64;   ///< m (4 x Kuri's radius): the later recovery forgets more
-  /// m: a goal someone stands on counts as reached this much beyond xy_goal_tolerance (the robot sent to the
-  /// participant's start finds the participant still there).
-  double occupied_goal_margin = 0.6;
+  /// m, centre to centre: where someone stands at the goal (within this distance of it, slower than
+  /// walking), the goal is that person, and the robot stops this far from them. 1.2 m is Hall's boundary
+  /// between the personal and the social zone (docs/sources.md / docs/sources.md): the robot sent to the
+  /// participant's start (SEAN-EP's mission) waits at social distance instead of walking into their space.
+  double person_goal_distance = 1.2;
+  /// m/s: a person at the goal slower than this is standing there (a walker crossing the goal is not a goal).
+  double person_goal_standing_speed = 0.1;
   /// rad: when the path ahead (rotate_lookahead along it) lies further than this from the robot's heading,
   /// the robot turns in place toward it before DWA drives (as nav2's rotation shim does). DWA alone scores
   /// every turn in place alike when the path is behind the robot, so it stalls facing a blocked corridor.

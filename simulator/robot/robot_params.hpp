@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // RobotParams: the whole robot's model in one place: base, sensors, localization, costmaps, planners and
-// navigator. Defaults follow REFERENCE.md (SEAN's Kuri and the SEAN-EP move_base); a scenario's
+// navigator. Defaults follow docs/sources.md (SEAN's Kuri and the SEAN-EP move_base); a scenario's
 // `robot.nav` section overrides them by ROS name (docs/scenarios.md).
 #pragma once
 
@@ -61,7 +61,7 @@ struct RobotParams {
   NavigatorParams navigator;
   /// m added to the robot's radius for the costmaps' footprint and inscribed radius (ROS's
   /// footprint_padding, 0.01 there): at 0.01 the local planner let the robot brush past people 1-2 cm away
-  /// (a collision by REFERENCE.md's 2 cm rule) in 5 of 50 warehouse trials.
+  /// (a collision by docs/sources.md's 2 cm rule) in 5 of 50 warehouse trials.
   double footprint_padding = 0.05;
   double head_max_rate = 3.0;   ///< rad/s the head turns at most
   double head_lookahead = 1.0;  ///< m along the global path the head looks at

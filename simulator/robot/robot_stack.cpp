@@ -164,18 +164,13 @@ void RobotStack::control_cycle(World& world) {
     scan_fresh_ = false;
   }
 
-  // Someone stands on the goal when their body and the robot's could not both be there.
-  bool goal_occupied = false;
-  if (const auto& goal = navigator_.goal()) {
-    for (const SeenPerson& person : seen_) {
-      const double reach = person.radius + robot.radius;
-      goal_occupied = goal_occupied || (person.position - Eigen::Vector2d(goal->x, goal->y)).norm() < reach;
-    }
-  }
+  // Someone standing at the goal makes them the goal: the robot stops at social distance from them.
+  std::optional<Eigen::Vector2d> goal_person;
+  if (const auto& goal = navigator_.goal()) goal_person = goal_person_at(*goal, seen_, setup_.params.navigator);
   navigator_.set_people(seen_);
   const NavigatorTimes before = navigator_.times();
   const NavCommand command =
-      navigator_.cycle(now, estimate, drive_.v(), drive_.w(), global_.grid(), local_.grid(), goal_occupied);
+      navigator_.cycle(now, estimate, drive_.v(), drive_.w(), global_.grid(), local_.grid(), goal_person);
   const NavigatorTimes& after = navigator_.times();
   const auto plan_index = static_cast<std::size_t>(NavStage::GlobalPlan);
   const auto local_index = static_cast<std::size_t>(NavStage::LocalPlan);

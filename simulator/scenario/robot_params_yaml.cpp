@@ -28,7 +28,7 @@ std::vector<Setting> settings(RobotParams& p) {
   CostmapParams& g = p.global_costmap;
   CostmapParams& l = p.local_costmap;
   return {
-      // The base (REFERENCE.md: Kuri).
+      // The base (docs/sources.md: Kuri).
       {"drive", "max_vel_x", &p.drive.max_vel_x, 0.0, 5.0},
       {"drive", "min_vel_x", &p.drive.min_vel_x, -5.0, 0.0},
       {"drive", "max_vel_theta", &p.drive.max_vel_theta, 0.1, 20.0},
@@ -111,6 +111,9 @@ std::vector<Setting> settings(RobotParams& p) {
       {"move_base", "yaw_goal_tolerance", &p.navigator.yaw_goal_tolerance, 0.01, 10.0},
       {"move_base", "waypoint_pause", &p.navigator.waypoint_pause, 0.0, 3600.0},
       {"move_base", "rotate_to_path_angle", &p.navigator.rotate_to_path_angle, 0.2, 3.15},
+      // rfbsim: the goal that is a person (docs/scenarios.md); below 0.45 m would be Hall's intimate zone.
+      {"move_base", "person_goal_distance", &p.navigator.person_goal_distance, 0.45, 10.0},
+      {"move_base", "person_goal_standing_speed", &p.navigator.person_goal_standing_speed, 0.0, 5.0},
       // DWA local planner (ROS dwa_local_planner names).
       {"dwa", "max_vel_x", &p.dwa.max_vel_x, 0.0, 5.0},
       {"dwa", "min_vel_x", &p.dwa.min_vel_x, -5.0, 5.0},
@@ -131,6 +134,8 @@ std::vector<Setting> settings(RobotParams& p) {
       {"dwa", "forward_point_distance", &p.dwa.forward_point_distance, 0.0, 5.0},
       {"dwa", "people_clearance", &p.dwa.people_clearance, 0.0, 5.0},
       {"dwa", "people_horizon", &p.dwa.people_horizon, 0.0, 10.0},
+      {"dwa", "people_personal_clearance", &p.dwa.people_personal_clearance, 0.0, 5.0},
+      {"dwa", "people_walking_speed", &p.dwa.people_walking_speed, 0.0, 5.0},
       {"dwa", "oscillation_reset_dist", &p.dwa.oscillation_reset_dist, 0.0, 10.0},
       {"dwa", "oscillation_reset_angle", &p.dwa.oscillation_reset_angle, 0.0, 10.0},
   };

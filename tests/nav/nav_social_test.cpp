@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "nav_run.hpp"
+#include "scenario/robot_params_yaml.hpp"
 
 namespace sim = rfbsim::sim;
 using rfbsim::test::BareWorld;
@@ -70,4 +71,40 @@ TEST_CASE("nav: people blocking the short corridor make the robot replan the lon
   // The robot went the long way round the south corridor: over 15 m driven, where the short way is 12 m.
   CHECK(run.metrics.path_length > 15.0);
   CHECK_FALSE(run.hit_wall);
+}
+
+TEST_CASE("nav: the goal is a person only when someone stands within the social distance of it", "[nav][social]") {
+  sim::NavigatorParams params;  // person_goal_distance 1.2 m, standing below 0.1 m/s
+  const sim::Pose2 goal{5.0, 5.0, 0.0};
+  const sim::SeenPerson far{{6.3, 5.0}, {0.0, 0.0}, 0.25};      // 1.3 m off: not at the goal
+  const sim::SeenPerson near{{5.0, 6.0}, {0.05, 0.0}, 0.25};    // 1.0 m off, shuffling: at the goal
+  const sim::SeenPerson nearer{{5.5, 5.0}, {0.0, 0.0}, 0.25};   // 0.5 m off, standing: nearer still
+  const sim::SeenPerson walker{{5.0, 5.1}, {1.2, 0.0}, 0.25};   // crossing the goal: not a goal
+  CHECK_FALSE(sim::goal_person_at(goal, std::vector<sim::SeenPerson>{far, walker}, params));
+  CHECK(sim::goal_person_at(goal, std::vector<sim::SeenPerson>{far, near}, params) == near.position);
+  CHECK(sim::goal_person_at(goal, std::vector<sim::SeenPerson>{near, walker, nearer}, params) == nearer.position);
+  params.person_goal_distance = 2.0;
+  CHECK(sim::goal_person_at(goal, std::vector<sim::SeenPerson>{far}, params) == far.position);
+}
+
+TEST_CASE("nav: the social settings are scenario keys, checked with the key named", "[nav][social]") {
+  const auto parse = [](const std::string& text) {
+    sim::RobotParams params;
+    sim::parse_robot_params(sim::YamlField(YAML::Load(text), "social.yaml"), params);
+    return params;
+  };
+  const sim::RobotParams params = parse(
+      "dwa: {people_personal_clearance: 0.6, people_walking_speed: 0.3}\n"
+      "move_base: {person_goal_distance: 2.0, person_goal_standing_speed: 0.2}\n"
+      "proxemic: {amplitude: 100, covariance: 0.1}\n");
+  CHECK(params.dwa.people_personal_clearance == 0.6);
+  CHECK(params.dwa.people_walking_speed == 0.3);
+  CHECK(params.navigator.person_goal_distance == 2.0);
+  CHECK(params.navigator.person_goal_standing_speed == 0.2);
+  CHECK(params.local_costmap.proxemic.covariance == 0.1);  // one proxemic model for both costmaps
+  CHECK_THROWS_WITH(parse("dwa: {people_personal_clearance: -0.1}"), Catch::Contains("dwa.people_personal_clearance"));
+  CHECK_THROWS_WITH(parse("dwa: {people_walking_speed: fast}"), Catch::Contains("people_walking_speed"));
+  // Closer than Hall's intimate zone is no social distance.
+  CHECK_THROWS_WITH(parse("move_base: {person_goal_distance: 0.3}"), Catch::Contains("person_goal_distance"));
+  CHECK_THROWS_WITH(parse("proxemic: {covariance: 0}"), Catch::Contains("proxemic.covariance"));
 }

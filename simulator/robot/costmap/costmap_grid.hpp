@@ -12,7 +12,7 @@
 
 namespace rfbsim::sim {
 
-/// costmap_2d's cost classes (REFERENCE.md, Costmap).
+/// costmap_2d's cost classes (docs/sources.md, Costmap).
 namespace cost {
 inline constexpr std::uint8_t kFree = 0;
 inline constexpr std::uint8_t kInscribed = 253;  ///< the footprint's centre here touches an obstacle

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Parameters of the layered costmap and of each layer, with ROS's names where ROS has one and the
-// defaults of REFERENCE.md (costmap_2d, social_navigation_layers, SEAN's Kuri).
+// defaults of docs/sources.md (costmap_2d, social_navigation_layers, SEAN's Kuri).
 #pragma once
 
 namespace rfbsim::sim {
@@ -42,7 +42,7 @@ struct CostmapParams {
   ProxemicLayerParams proxemic;    ///< amplitude, covariance, cutoff, factor
 };
 
-/// Kuri's global costmap (REFERENCE.md): the whole map, inflation 0.3 m.
+/// Kuri's global costmap (docs/sources.md): the whole map, inflation 0.3 m.
 CostmapParams global_costmap_params();
 /// Kuri's local costmap: a width x height m window on the robot, inflation `inflation_radius` m
 /// (SEAN's Kuri used 0.1 m).

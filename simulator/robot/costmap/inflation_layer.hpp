@@ -16,7 +16,7 @@
 
 namespace rfbsim::sim {
 
-/// The cost of a cell `distance` m (between cell centres) from the nearest lethal cell (REFERENCE.md):
+/// The cost of a cell `distance` m (between cell centres) from the nearest lethal cell (docs/sources.md):
 /// 254 at 0; 0 beyond inflation_radius; else 253 up to `inscribed_radius` and
 /// floor(252 exp(-cost_scaling_factor (d - inscribed_radius))) past it. The comparisons allow 1e-9 m, so
 /// that 6 cells of 0.05 m count as 0.3 m.

@@ -29,7 +29,7 @@ struct DwaParams {
 
   // Scoring: cost = path * path distance (m) + goal * goal distance (m) + occdist * max cell cost (0..252).
   // dwa_local_planner's defaults, 32 and 24 (it scales them by the resolution and measures in cells: per
-  // metre that is 32 and 24). REFERENCE.md's 0.6 and 0.8 are base_local_planner's pdist_scale and
+  // metre that is 32 and 24). docs/sources.md's 0.6 and 0.8 are base_local_planner's pdist_scale and
   // gdist_scale, which weigh cells, not metres; taken per metre they let a cell of cost 200 outweigh 2.5 m
   // of distance, and the robot stalled turning in place at inner corners.
   double path_distance_bias = 32.0;     ///< weight per m between a rollout's end and the global path
@@ -41,6 +41,17 @@ struct DwaParams {
   double robot_radius = 0.16;      ///< m, the body the people critic keeps clear (the stack sets the robot's)
   double people_clearance = 0.1;   ///< m kept between the robot's and a person's bodies, people predicted ahead
   double people_horizon = 1.0;     ///< s of constant-velocity prediction; 0 switches the critic off
+  /// m kept between the bodies while the robot itself moves toward a walking person (issue 19): within
+  /// this gap a rollout may stop, turn, move aside or away, but not close in on someone who walks. 0.45 m
+  /// puts a 0.25 m person's centre 0.86 m from Kuri's: outside Hall's intimate zone by a margin, at the
+  /// near edge of the personal zone. Standing people are the proxemic layer's (the robot must be able to
+  /// pass someone waiting in an aisle); 0 switches the rule off (the behaviour before issue 19).
+  double people_personal_clearance = 0.45;
+  /// m/s: people at least this fast walk, for the rule above. 0.5 m/s is the slowest walking speed the
+  /// crowd draws (docs/sources.md: libpedsim's clamp); someone slower is waiting or turning, and the robot must
+  /// still be able to pass them (0.1 m/s: the robot dithered where people mill about the storage gate, and
+  /// lost its localization doing so in 2 of 50 trials, against 1 with 0.5).
+  double people_walking_speed = 0.5;
 
   // Oscillation suppression.
   double oscillation_reset_dist = 0.05;   ///< m the robot must move before a reversed turn is allowed again

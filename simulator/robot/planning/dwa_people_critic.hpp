@@ -3,7 +3,10 @@
 // person crossing the robot's way moves 0.13 m between two control cycles. This critic predicts each person
 // the robot sees at constant velocity over the first `people_horizon` seconds of every rollout and rejects a
 // rollout that would bring the two bodies closer than `people_clearance`; one that moves away from someone
-// already that close stays legal, so the robot can always back out of a squeeze.
+// already that close stays legal, so the robot can always back out of a squeeze. A second, wider rule keeps
+// the robot from closing in on people who walk (issue 19): within `personal_clearance` of a walking person's
+// predicted position, a rollout point that the robot's own step brings nearer that position is illegal, so
+// the robot stops, turns or moves aside while a walker passes close, and never drives up to them itself.
 #pragma once
 
 #include <span>
@@ -17,9 +20,12 @@ namespace rfbsim::sim {
 class PeopleCritic final : public DwaCritic {
  public:
   /// `robot_radius` m; `clearance` m between the bodies' surfaces; `horizon` s of prediction; `sim_time` s
-  /// that a rollout's points up to its `end` span.
-  PeopleCritic(double robot_radius, double clearance, double horizon, double sim_time)
-      : robot_radius_(robot_radius), clearance_(clearance), horizon_(horizon), sim_time_(sim_time) {}
+  /// that a rollout's points up to its `end` span; `personal_clearance` m between the bodies within which
+  /// the robot may not close in on a person walking at least `walking_speed` m/s (0: no such rule).
+  PeopleCritic(double robot_radius, double clearance, double horizon, double sim_time, double personal_clearance = 0.0,
+               double walking_speed = 0.1)
+      : robot_radius_(robot_radius), clearance_(clearance), horizon_(horizon), sim_time_(sim_time),
+        personal_clearance_(personal_clearance), walking_speed_(walking_speed) {}
 
   [[nodiscard]] const char* name() const override { return "people"; }
   [[nodiscard]] const char* rejection() const override { return "come too close to a person"; }
@@ -33,6 +39,8 @@ class PeopleCritic final : public DwaCritic {
   double clearance_;
   double horizon_;
   double sim_time_;
+  double personal_clearance_;
+  double walking_speed_;
   std::vector<SeenPerson> people_;
 };
 

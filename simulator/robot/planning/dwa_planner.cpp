@@ -37,8 +37,10 @@ std::string dwa_params_error(const DwaParams& p) {
   }
   if (!non_negative(p.path_distance_bias) || !non_negative(p.goal_distance_bias) || !non_negative(p.occdist_scale) ||
       !non_negative(p.forward_point_distance) || !non_negative(p.oscillation_reset_dist) ||
-      !non_negative(p.oscillation_reset_angle)) {
-    return "bad DWA parameters: biases, scales and distances must be >= 0";
+      !non_negative(p.oscillation_reset_angle) || !non_negative(p.people_clearance) ||
+      !non_negative(p.people_horizon) || !non_negative(p.people_personal_clearance) ||
+      !non_negative(p.people_walking_speed)) {
+    return "bad DWA parameters: biases, scales, distances, people clearances, horizon and walking speed must be >= 0";
   }
   return {};
 }
@@ -59,7 +61,8 @@ DwaPlanner::DwaPlanner(DwaParams params)
     : params_(params),
       params_error_(dwa_params_error(params)),
       oscillation_(params.oscillation_reset_dist, params.oscillation_reset_angle, params.min_vel_trans),
-      people_(params.robot_radius, params.people_clearance, params.people_horizon, params.sim_time),
+      people_(params.robot_radius, params.people_clearance, params.people_horizon, params.sim_time,
+              params.people_personal_clearance, params.people_walking_speed),
       path_("path_distance", MapDistanceCritic::Target::Path, 0.0, false),
       goal_("goal_distance", MapDistanceCritic::Target::Goal, 0.0, false),
       alignment_("alignment", MapDistanceCritic::Target::Path, params.forward_point_distance, true),

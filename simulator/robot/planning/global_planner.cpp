@@ -62,7 +62,7 @@ GlobalPlanner::GlobalPlanner(GlobalPlannerParams params) : params_(params) {}
 
 void GlobalPlanner::build_cost_table() {
   // global_planner's cell cost: neutral + factor * c, capped one below lethal so that no passable cell costs
-  // as much as an impassable one (REFERENCE.md: 50 + 3c capped at 252).
+  // as much as an impassable one (docs/sources.md: 50 + 3c capped at 252).
   const double cap = std::max(1, params_.lethal_cost - 1);
   for (int c = 0; c < 256; ++c) {
     const bool unknown_ok = params_.allow_unknown && c == cost::kUnknown;

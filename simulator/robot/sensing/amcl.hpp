@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Amcl: Monte Carlo localization in the style of ROS's amcl (REFERENCE.md, Localization): a particle filter
+// Amcl: Monte Carlo localization in the style of ROS's amcl (docs/sources.md, Localization): a particle filter
 // over the robot's pose with the odometry motion model and the likelihood-field laser model, updated only
 // after the robot moved update_min_d or turned update_min_a, resampled by low-variance sampling.
 //

@@ -32,7 +32,7 @@
 
 namespace rfbsim::sim {
 
-/// The lidar's model (REFERENCE.md, SEAN's Kuri robot: TurtleBot3-like 360 beams, sigma 0.01 m).
+/// The lidar's model (docs/sources.md, SEAN's Kuri robot: TurtleBot3-like 360 beams, sigma 0.01 m).
 struct LidarParams {
   int beams = 360;                      ///< beams per sweep, >= 1
   double fov = 6.283185307179586;       ///< rad, field of view (2 pi: all round)
