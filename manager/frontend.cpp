@@ -600,7 +600,12 @@ class FrontendImpl final : public Frontend, public SessionListener {
     // Only the participant counts as connected: a researcher watching must not keep an idle session alive.
     if (kind == RelayKind::kParticipant) supervisor_.client_connected(session->id);
     // sim_rfb takes the browser's address from a PROXY line; a legacy program would take it for RFB bytes.
-    if (config_.session_kind == SessionKind::kSimRfb) relay->set_proxy_line(proxy_line_for(*con));
+    // A watcher's line names no address but marks it view-only (v1 lets UNKNOWN carry that word), so that
+    // sim_rfb records it as a watcher and it does not start the participant's task clock.
+    if (config_.session_kind == SessionKind::kSimRfb) {
+      relay->set_proxy_line(kind == RelayKind::kWatch ? std::string("PROXY UNKNOWN view-only\r\n")
+                                                      : proxy_line_for(*con));
+    }
     if (session->state == SessionState::kRunning) relay->connect(session->port, session->unix_socket);
   }
 

@@ -48,6 +48,8 @@ bool is_address(std::string_view text, int family) {
 }  // namespace
 
 ProxyHeader parse_proxy_header(std::string_view first_bytes) {
+  // sim_manager's mark on a watch connection, after UNKNOWN (see the header).
+  constexpr std::string_view kViewOnlyWord = "view-only";
   ProxyHeader header;
   constexpr std::string_view kSignature = "PROXY ";
   // Every prefix of the signature may still become one; anything else cannot.
@@ -67,6 +69,8 @@ ProxyHeader parse_proxy_header(std::string_view first_bytes) {
   if (!parts.empty() && parts[0] == "UNKNOWN") {
     header.status = ProxyHeader::Status::Valid;  // the relay does not know; the rest of the line is ignored
     header.length = end + 2;
+    // Only the exact word counts: any other text after UNKNOWN (another relay's) stays a plain UNKNOWN.
+    header.view_only = parts.size() == 2 && parts[1] == kViewOnlyWord;
     return header;
   }
   if (parts.size() != 5) return header;

@@ -2,6 +2,8 @@
 // The PROXY protocol's version 1 header (HAProxy's), with which a trusted relay in front of the server
 // tells it the real client's address: one line "PROXY TCP4 <src> <dst> <sport> <dport>\r\n" (TCP6 alike,
 // or "PROXY UNKNOWN...\r\n"), at most 107 bytes, before the client's own bytes. Pure: no sockets.
+// Version 1 lets UNKNOWN carry anything up to CR LF, which receivers ignore; sim_manager uses that room
+// for one word of its own, "PROXY UNKNOWN view-only\r\n", marking a researcher's watch connection.
 #pragma once
 
 #include <cstddef>
@@ -22,6 +24,7 @@ struct ProxyHeader {
   Status status = Status::Incomplete;
   std::size_t length = 0;  ///< bytes of the header, CR LF included (Valid)
   std::string source;      ///< the source address as written ("203.0.113.5", "2001:db8::1"); "" for UNKNOWN
+  bool view_only = false;  ///< the line was exactly "PROXY UNKNOWN view-only": the relay's watcher (Valid)
 };
 
 /// Looks at the first bytes a connection sent.

@@ -57,12 +57,14 @@ rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
   state->info.id = self.next_client_id++;
   state->info.address = self.adopting_address.empty() ? peer_address(cl->sock) : self.adopting_address;
   state->info.websocket = cl->wsctx != nullptr;
+  state->info.view_only = self.adopting_view_only;
   state->guard_fd = std::exchange(self.adopting_guard_fd, -1);
   state->connected = Clock::now();
   self.full_refusals = 0;
   cl->clientData = state;
   cl->clientFramebufferUpdateRequestHook = on_update_request;
-  cl->viewOnly = self.options.view_only ? TRUE : FALSE;
+  // libvncserver then drops the client's keys and pointer itself; on_key and on_pointer check again.
+  cl->viewOnly = self.options.view_only || state->info.view_only ? TRUE : FALSE;
   ++self.clients;
   if (self.options.on_connect) self.options.on_connect(state->info);
   return RFB_CLIENT_ACCEPT;
@@ -95,7 +97,7 @@ void Server::Impl::on_client_gone(rfbClientPtr cl) {
 void Server::Impl::on_key(rfbBool down, rfbKeySym keysym, rfbClientPtr cl) {
   Impl& self = of(cl);
   const auto* state = static_cast<ClientState*>(cl->clientData);
-  if (self.options.view_only || state == nullptr) return;
+  if (self.options.view_only || state == nullptr || state->info.view_only) return;
   InputEvent event;
   event.kind = InputEvent::Kind::Key;
   event.time = Clock::now();
@@ -109,7 +111,7 @@ void Server::Impl::on_key(rfbBool down, rfbKeySym keysym, rfbClientPtr cl) {
 void Server::Impl::on_pointer(int mask, int x, int y, rfbClientPtr cl) {
   Impl& self = of(cl);
   const auto* state = static_cast<ClientState*>(cl->clientData);
-  if (self.options.view_only || state == nullptr) return;
+  if (self.options.view_only || state == nullptr || state->info.view_only) return;
   InputEvent event;
   event.kind = InputEvent::Kind::Pointer;
   event.time = Clock::now();

@@ -51,6 +51,7 @@ struct PendingConnection {
   Clock::time_point accepted{};
   bool proxied = false;   // its PROXY line was read (or none is expected)
   std::string address;    // from the PROXY line; "" = the socket's peer
+  bool view_only = false; // its PROXY line marked it view-only (the relay's watcher)
 };
 
 struct Server::Impl {
@@ -71,9 +72,10 @@ struct Server::Impl {
   // it 403 and closing the socket.
   bool admit_websocket(int fd, std::string_view head);
   void log_refused_origin(const std::string& origin);
-  // Hands a connection to libvncserver; `address` (from a PROXY line) replaces the socket's peer if given.
+  // Hands a connection (already off the intake list) to libvncserver; its address (from a PROXY line)
+  // replaces the socket's peer if given, and a view-only mark makes it a viewer whose input is dropped.
   // `head_checked`: a WebSocket head, if any, has been seen and its Origin admitted (or needs none).
-  void adopt_rfb(int fd, const std::string& address, bool head_checked);
+  void adopt_rfb(const PendingConnection& connection, bool head_checked);
   // How long a connection's first bytes may take before it is judged by what came (see kSniffTimeout).
   [[nodiscard]] Clock::duration sniff_timeout() const {
     return serves_http ? Clock::duration(kSniffTimeout) : Clock::duration(kRfbOnlySniffTimeout);
@@ -128,6 +130,7 @@ struct Server::Impl {
   int adopting_guard_fd = -1;             // handed from adopt_rfb to on_new_client
   std::string adopting_address;           // handed from adopt_rfb to on_new_client; "" = the socket's peer
   bool adopting_head_checked = false;     // handed from adopt_rfb to on_new_client
+  bool adopting_view_only = false;        // handed from adopt_rfb to on_new_client
   bool any_backed_up = false;             // some client's output is above kMaxUnsentBytes
   detail::StreamerConfig streamer_config;  // what each client's ClientStreamer starts from
   Clock::time_point streams_published{};  // when `streams` was last refreshed

@@ -93,7 +93,7 @@ void Server::Impl::add_pending(int fd, Clock::time_point now) {
     ::close(fd);
     return;
   }
-  pending.push_back({fd, now, !options.proxy_protocol, ""});
+  pending.push_back({fd, now, !options.proxy_protocol, "", false});
 }
 
 std::vector<PendingConnection>::iterator Server::Impl::release_pending(std::vector<PendingConnection>::iterator it) {
@@ -125,7 +125,7 @@ void Server::Impl::classify_pending() {
       if (!serves_http) {
         const PendingConnection connection = *it;
         it = release_pending(it);
-        adopt_rfb(connection.fd, connection.address, true);
+        adopt_rfb(connection, true);
         continue;
       }
       ++it;  // sniff the client's own bytes when they come (the epoll set reports them)
@@ -148,10 +148,10 @@ void Server::Impl::classify_pending() {
       case detail::WireProtocol::Undecided:
         break;
       case detail::WireProtocol::Rfb:
-        adopt_rfb(connection.fd, connection.address, false);
+        adopt_rfb(connection, false);
         break;
       case detail::WireProtocol::WebSocket:
-        if (admit_websocket(connection.fd, bytes)) adopt_rfb(connection.fd, connection.address, true);
+        if (admit_websocket(connection.fd, bytes)) adopt_rfb(connection, true);
         break;
       case detail::WireProtocol::Http:
         // Nothing is served over HTTP here: closed unanswered, as libvncserver would a bad RFB client.
@@ -184,6 +184,7 @@ bool Server::Impl::take_proxy_header(PendingConnection& connection, std::string_
   if (n != static_cast<ssize_t>(header.length)) return false;
   connection.proxied = true;
   connection.address = header.source;
+  connection.view_only = header.view_only;
   connection.accepted = now;  // the sniff's clock starts with the client's own bytes
   return true;
 }
@@ -229,7 +230,8 @@ void Server::Impl::log_refused_origin(const std::string& origin) {
                static_cast<int>(std::min(origin.size(), kMaxLoggedOriginBytes)), origin.c_str());
 }
 
-void Server::Impl::adopt_rfb(int fd, const std::string& address, bool head_checked) {
+void Server::Impl::adopt_rfb(const PendingConnection& connection, bool head_checked) {
+  const int fd = connection.fd;
   // Full: refused here, before libvncserver's own WebSocket sniff, which holds this thread up to 100 ms
   // for every silent connection (so a flood of idle connections costs nothing once the slots are taken).
   if (clients.load() >= options.max_clients) {
@@ -253,7 +255,8 @@ void Server::Impl::adopt_rfb(int fd, const std::string& address, bool head_check
     return;
   }
   adopting_guard_fd = guard;
-  adopting_address = address;
+  adopting_address = connection.address;
+  adopting_view_only = connection.view_only;
   adopting_head_checked = head_checked;
   watchdog.arm(guard, Clock::now() + options.read_timeout);
   rfbNewClient(screen, fd);

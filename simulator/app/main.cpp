@@ -356,8 +356,10 @@ int run(const rfbsim::sim::SimOptions& options) {
     // Viewers and input drained now are recorded at this tick and take effect from the next one.
     for (const ClientChanges::Change& change : client_changes.take()) {
       if (change.connected) {
+        // A researcher's watch connection (marked view-only by sim_manager's relay) must not start the clock.
         study.client_connected(change.client.id, sim::hash_address(address_key, change.client.address),
-                               change.client.websocket);
+                               change.client.websocket,
+                               change.client.view_only ? sim::ViewerRole::kWatcher : sim::ViewerRole::kParticipant);
       } else {
         study.client_disconnected(change.client.id, sim::hash_address(address_key, change.client.address),
                                   change.client.websocket);

@@ -4,6 +4,8 @@
 
 namespace rfbsim::sim {
 
+const char* viewer_role_name(ViewerRole role) { return role == ViewerRole::kWatcher ? "watcher" : "participant"; }
+
 StudySession::StudySession(Simulation& simulation, TaskSpec task, StudyCodes codes, SessionWriter* writer)
     : simulation_(simulation), monitor_(std::move(task), simulation.params().dt), codes_(std::move(codes)), writer_(writer) {
   if (writer_ == nullptr) return;
@@ -24,13 +26,17 @@ void StudySession::pointer(int x, int y, int buttons, int client) {
   writer_->event(simulation_.world().tick, "pointer", {{"x", x}, {"y", y}, {"buttons", buttons}, {"client", client}});
 }
 
-void StudySession::client_connected(int client, const std::string& address_hash, bool websocket) {
+void StudySession::client_connected(int client, const std::string& address_hash, bool websocket, ViewerRole role) {
   if (writer_ != nullptr) {
-    writer_->event(simulation_.world().tick, "client",
-                   {{"event", "connect"}, {"client", client}, {"address", address_hash}, {"websocket", websocket}});
+    // The role only when it is a watcher: participants' events stay as they were, so older logs replay alike.
+    nlohmann::ordered_json fields = {
+        {"event", "connect"}, {"client", client}, {"address", address_hash}, {"websocket", websocket}};
+    if (role == ViewerRole::kWatcher) fields["role"] = viewer_role_name(role);
+    writer_->event(simulation_.world().tick, "client", fields);
   }
-  // The clock starts when the participant can first see the world, not when the process started.
-  monitor_.start_timer(simulation_.world());
+  // The clock starts when the participant can first see the world, not when the process started, and not
+  // when a researcher opened the session to watch it (before the participant came, or without one at all).
+  if (role == ViewerRole::kParticipant) monitor_.start_timer(simulation_.world());
   record_task_events();
 }
 

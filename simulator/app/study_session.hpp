@@ -14,6 +14,13 @@
 
 namespace rfbsim::sim {
 
+/// Who a viewer is: the participant, whose first sight of the world starts the task's clock, or a researcher
+/// watching through sim_manager's view-only relay, who must never start it.
+enum class ViewerRole { kParticipant, kWatcher };
+
+/// "participant" or "watcher", as session data records it.
+const char* viewer_role_name(ViewerRole role);
+
 /// The completion codes a link carried (SEAN-EP's t1 and t2); empty = none to show.
 struct StudyCodes {
   std::string success;
@@ -29,8 +36,10 @@ class StudySession {
   void key(std::uint32_t keysym, bool down, int client);
   /// Pointer moves and buttons: recorded, not used.
   void pointer(int x, int y, int buttons, int client);
-  /// A viewer arrived: recorded with its hashed address; the first one starts the task's clock.
-  void client_connected(int client, const std::string& address_hash, bool websocket);
+  /// A viewer arrived: recorded with its hashed address and role; the first participant starts the task's
+  /// clock (a watcher is recorded with "role":"watcher" and starts nothing).
+  void client_connected(int client, const std::string& address_hash, bool websocket,
+                        ViewerRole role = ViewerRole::kParticipant);
   /// A viewer left (recorded with the same hashed address as its connect).
   void client_disconnected(int client, const std::string& address_hash, bool websocket);
 

@@ -2,7 +2,8 @@
 // Fuzz target: the PROXY protocol version 1 header parser.
 // Invariants: a Valid header is "PROXY ...\r\n" of at most 107 bytes, parses the same on its own and is
 // Incomplete one byte short; its source is an address inet_pton reads; Incomplete means no line end yet,
-// and every shorter prefix of an Incomplete input is Incomplete too.
+// and every shorter prefix of an Incomplete input is Incomplete too; view_only only for a Valid line that is
+// exactly "PROXY UNKNOWN view-only".
 #include <arpa/inet.h>
 
 #include <string>
@@ -25,7 +26,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       check(bytes.substr(0, header.length - 2).find("\r\n") == std::string_view::npos, "CR LF before the end");
       const ProxyHeader alone = parse_proxy_header(bytes.substr(0, header.length));
       check(alone.status == ProxyHeader::Status::Valid && alone.length == header.length &&
-                alone.source == header.source,
+                alone.source == header.source && alone.view_only == header.view_only,
             "the header alone parses differently");
       check(parse_proxy_header(bytes.substr(0, header.length - 1)).status == ProxyHeader::Status::Incomplete,
             "a header one byte short is not Incomplete");
@@ -36,10 +37,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       } else {
         check(bytes.substr(6, 7) == "UNKNOWN", "no source but not UNKNOWN");
       }
+      check(header.view_only == (bytes.substr(0, header.length) == "PROXY UNKNOWN view-only\r\n"),
+            "view_only is not exactly the view-only line");
       break;
     }
     case ProxyHeader::Status::Incomplete:
       check(bytes.size() < kMaxProxyHeaderBytes, "Incomplete beyond the size limit");
+      check(!header.view_only, "view_only before the line is whole");
       check(bytes.find("\r\n") == std::string_view::npos, "Incomplete with a line end");
       if (!bytes.empty()) {
         check(parse_proxy_header(bytes.substr(0, bytes.size() - 1)).status == ProxyHeader::Status::Incomplete,
@@ -47,7 +51,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       break;
     case ProxyHeader::Status::Invalid:
-      check(header.length == 0 && header.source.empty(), "Invalid with a length or source");
+      check(header.length == 0 && header.source.empty() && !header.view_only, "Invalid with a length, source or mark");
       break;
   }
   return 0;

@@ -127,6 +127,35 @@ TEST_CASE("a session whose viewer left and another came back replays with the sa
   CHECK(contains(run.output, "outcome matches: timeout at tick " + std::to_string(*recording.outcome_tick)));
 }
 
+TEST_CASE("a researcher who watched before the participant came replays with the clock from the participant") {
+  // As sim_rfb records it: the watcher's connect carries "role":"watcher" and starts no clock; the
+  // participant's, 100 ticks later, does. A replay that took the watcher for the participant would time
+  // out 100 ticks early.
+  const auto dir = test::fresh_dir("watched_first");
+  test::RecordSpec spec;
+  spec.time_limit = 3.0;
+  spec.connect_tick = 110;
+  spec.max_ticks = 60 * 60;
+  spec.script = [](sim::StudySession& study, std::uint64_t tick) {
+    if (tick == 10) study.client_connected(2, "aaaaaaaaaaaaaaaa", true, sim::ViewerRole::kWatcher);
+    if (tick == 120) study.key('w', true, 1);
+    if (tick == 200) study.key('w', false, 1);
+  };
+  const test::Recording recording = test::record_session(spec, dir);
+  REQUIRE(recording.outcome == sim::TaskOutcome::Timeout);
+  bool watcher_recorded = false;
+  for (const auto& event : sim::read_session(dir).events) {
+    if (event.type == "client" && event.integer("client") == 2) watcher_recorded = event.text("role") == "watcher";
+  }
+  REQUIRE(watcher_recorded);
+
+  const test::ReplayRun run = test::run_replay({dir.string()});
+  INFO(run.output);
+  CHECK(run.exit_code == 0);
+  CHECK(contains(run.output, "poses match the log"));
+  CHECK(contains(run.output, "outcome matches: timeout at tick " + std::to_string(*recording.outcome_tick)));
+}
+
 TEST_CASE("a session cut short by a crash replays to its last trajectory row, and what it has matches") {
   const auto dir = test::fresh_dir("crashed");
   record_lab_short(dir);

@@ -176,3 +176,58 @@ TEST_CASE("a participant who does nothing in the lab times out at the limit and 
   CHECK(agents[1]["kind"] == "robot");
   CHECK(agents[1]["radius"] == 0.16);
 }
+
+TEST_CASE("a researcher watching before the participant comes does not start the participant's clock") {
+  SessionSetup setup;
+  setup.scenario = "lab";
+  setup.time_limit = 3.0;
+  PreparedSession prepared = prepare_session(setup);
+  Simulation& simulation = *prepared.simulation;
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "lab_watched";
+  {
+    SessionWriter writer(dir, info_for(prepared, "p-watched"), simulation.world());
+    StudySession study(simulation, prepared.task, {"OK-1", "LATE-2"}, &writer);
+    study.client_connected(1, "aaaaaaaaaaaaaaaa", false, ViewerRole::kWatcher);  // at tick 0
+    for (int i = 0; i < 300; ++i) study.step();
+    // Five seconds watched, longer than the whole limit: no clock, no step, no outcome.
+    CHECK_FALSE(study.task().outcome_tick());
+    CHECK(study.outcome() == TaskOutcome::None);
+    study.client_disconnected(1, "aaaaaaaaaaaaaaaa", false);
+    study.client_connected(2, "0123456789abcdef", false);  // the participant, at tick 300
+    study.client_connected(3, "aaaaaaaaaaaaaaaa", false, ViewerRole::kWatcher);  // a second look changes nothing
+    while (!study.over() && simulation.world().tick < 60 * 60) study.step();
+    REQUIRE(study.outcome() == TaskOutcome::Timeout);
+    CHECK(*study.task().outcome_tick() == 300 + 180);
+    study.finish("timeout");
+  }
+  // The record says who came when, and the clock started with the participant only.
+  std::vector<std::string> story;
+  for (const std::string& line : lines_of(dir / "events.jsonl")) {
+    const json event = json::parse(line);
+    if (event["type"] == "client") {
+      story.push_back("client:" + event["event"].get<std::string>() + ":" + std::to_string(event["client"].get<int>()) +
+                      ":" + event.value("role", std::string("participant")) + "@" + std::to_string(event["tick"].get<int>()));
+    } else if (event["type"] == "timer") {
+      story.push_back("timer@" + std::to_string(event["tick"].get<int>()));
+    }
+  }
+  const std::vector<std::string> expected = {"client:connect:1:watcher@0", "client:disconnect:1:participant@300",
+                                             "client:connect:2:participant@300", "timer@300",
+                                             "client:connect:3:watcher@300"};
+  CHECK(story == expected);
+  CHECK(viewer_role_name(ViewerRole::kWatcher) == std::string("watcher"));
+  CHECK(viewer_role_name(ViewerRole::kParticipant) == std::string("participant"));
+}
+
+TEST_CASE("a session only ever watched keeps its clock stopped") {
+  SessionSetup setup;
+  setup.scenario = "lab";
+  setup.time_limit = 1.0;
+  PreparedSession prepared = prepare_session(setup);
+  StudySession study(*prepared.simulation, prepared.task, {}, nullptr);
+  study.client_connected(1, "aaaaaaaaaaaaaaaa", false, ViewerRole::kWatcher);
+  for (int i = 0; i < 180; ++i) study.step();
+  CHECK(study.outcome() == TaskOutcome::None);
+  CHECK_FALSE(study.over());
+}

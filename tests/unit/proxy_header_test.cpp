@@ -25,6 +25,34 @@ TEST_CASE("TCP6 and UNKNOWN headers are valid too") {
   CHECK(unknown.length == 15);
 }
 
+TEST_CASE("exactly \"PROXY UNKNOWN view-only\" marks a watcher; any other UNKNOWN text is a plain UNKNOWN") {
+  const std::string line = "PROXY UNKNOWN view-only\r\n";
+  const auto watcher = parse_proxy_header(line + "RFB 003.008\n");
+  CHECK(watcher.status == Status::Valid);
+  CHECK(watcher.view_only);
+  CHECK(watcher.length == line.size());
+  CHECK(watcher.source.empty());
+  CHECK_FALSE(parse_proxy_header("PROXY UNKNOWN\r\n").view_only);
+  // Other relays may put anything after UNKNOWN: still valid, never view-only unless it is the exact word.
+  for (const char* other : {"PROXY UNKNOWN view-only2\r\n", "PROXY UNKNOWN View-Only\r\n", "PROXY UNKNOWN view\r\n",
+                            "PROXY UNKNOWN view-only extra\r\n", "PROXY UNKNOWN  view-only\r\n",
+                            "PROXY UNKNOWN view-only \r\n", "PROXY UNKNOWN 1.2.3.4 5.6.7.8 1 2\r\n"}) {
+    const auto header = parse_proxy_header(other);
+    INFO(other);
+    CHECK(header.status == Status::Valid);
+    CHECK_FALSE(header.view_only);
+  }
+  // The word elsewhere than after UNKNOWN marks nothing, and a TCP line stays what it was.
+  CHECK(parse_proxy_header("PROXY view-only\r\n").status == Status::Invalid);
+  const auto tcp = parse_proxy_header("PROXY TCP4 203.0.113.5 127.0.0.1 51234 40000\r\n");
+  CHECK(tcp.status == Status::Valid);
+  CHECK_FALSE(tcp.view_only);
+  // Still arriving: wait, and mark nothing yet.
+  const auto partial = parse_proxy_header("PROXY UNKNOWN view-on");
+  CHECK(partial.status == Status::Incomplete);
+  CHECK_FALSE(partial.view_only);
+}
+
 TEST_CASE("a header still arriving waits, at most 107 bytes") {
   CHECK(parse_proxy_header("").status == Status::Incomplete);
   CHECK(parse_proxy_header("PRO").status == Status::Incomplete);

@@ -61,6 +61,10 @@ struct ClientInfo {
   int id = 0;               ///< unique per server, counting from 1
   std::string address;      ///< peer address, e.g. "127.0.0.1"
   bool websocket = false;   ///< true when the client came in through WebSocket (a browser)
+  /// true when the trusted relay marked the connection view-only (its PROXY line was exactly
+  /// "PROXY UNKNOWN view-only", see ServerOptions::proxy_protocol): a watcher, whose keys and pointer are
+  /// dropped. A server-wide ServerOptions::view_only drops everyone's input but leaves this false.
+  bool view_only = false;
 };
 
 /// Counters since the server started. Encode time covers encoding and writing updates.
@@ -113,8 +117,9 @@ struct ServerOptions {
   /// Every connection must begin with a PROXY protocol version 1 line (HAProxy's), whose source address
   /// becomes the client's ClientInfo::address. For a trusted relay in front of the server, such as
   /// sim_manager's, so that the server knows the participant's address rather than the relay's. A
-  /// connection without a valid line within read_timeout is closed. Never enable it on a port that
-  /// untrusted peers reach directly: they could claim any address.
+  /// connection without a valid line within read_timeout is closed. The line "PROXY UNKNOWN view-only"
+  /// (the relay's watcher) makes a view-only client (ClientInfo::view_only). Never enable it on a port
+  /// that untrusted peers reach directly: they could claim any address.
   bool proxy_protocol = false;
   /// Pages whose WebSocket upgrades are accepted besides the server's own page (the request's Host, over
   /// http or https) and loopback pages (http(s)://127.0.0.1, localhost or [::1], any port): exact

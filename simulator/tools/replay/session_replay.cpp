@@ -85,7 +85,9 @@ void SessionReplay::apply(const sim::Event& event) {
   } else if (event.type == "client") {
     const std::string& what = event.text("event");
     if (what == "connect") {
-      study_->client_connected(small_int(event, "client"), event.text("address"), event.flag("websocket"));
+      // A watcher's connect (docs/data.md: "role":"watcher") did not start the clock live, so not here either.
+      const auto role = event.text("role") == "watcher" ? sim::ViewerRole::kWatcher : sim::ViewerRole::kParticipant;
+      study_->client_connected(small_int(event, "client"), event.text("address"), event.flag("websocket"), role);
     } else if (what == "disconnect") {
       study_->client_disconnected(small_int(event, "client"), event.text("address"), event.flag("websocket"));
     } else {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // A researcher watching a session from the admin page: the view is relayed view-only (the watcher's keys and
 // clicks never reach the session, the participant's do), it needs the admin token, it is framed by no survey,
-// and a watcher does not keep an idle session alive.
+// a watcher does not keep an idle session alive, and it does not start the participant's task clock.
 #include <catch2/catch.hpp>
 
 #include <arpa/inet.h>
@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "manager_process.hpp"
@@ -49,6 +50,28 @@ std::string read_text(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
+}
+
+// The lines of a session's events.jsonl written so far (a line still being written is left out).
+std::vector<nlohmann::json> read_events(const std::filesystem::path& file) {
+  std::vector<nlohmann::json> events;
+  std::istringstream lines(read_text(file));
+  std::string line;
+  while (std::getline(lines, line)) {
+    nlohmann::json event = nlohmann::json::parse(line, nullptr, false);
+    if (!event.is_discarded()) events.push_back(std::move(event));
+  }
+  return events;
+}
+
+// Where in `events` the first one of `type` (and, if given, with "event": `what`) is; -1 if none.
+int index_of(const std::vector<nlohmann::json>& events, const std::string& type, const std::string& what = "",
+             int from = 0) {
+  for (int i = from; i < static_cast<int>(events.size()); ++i) {
+    const auto& e = events[static_cast<std::size_t>(i)];
+    if (e.value("type", "") == type && (what.empty() || e.value("event", "") == what)) return i;
+  }
+  return -1;
 }
 
 // The watch WebSocket of session `token`, and bridge options that send `authorization` on its handshake.
@@ -277,4 +300,64 @@ TEST_CASE("a session with only a watcher connected still ends as idle", "[manage
   const auto row = manager.row_for_token(token);
   REQUIRE(row);
   CHECK(row->detail == "no browser connected for 1 s");
+}
+
+TEST_CASE("a researcher watching first does not start the participant's task clock; the participant does",
+          "[manager][watch][study]") {
+  TempDir data;
+  ManagerUnderTest manager(data.path(),
+                           with_small_sessions({"--admin-token", kAdminToken, "--first-connect-timeout-s", "120"}));
+  // The warehouse has a task, so its clock starts (a "timer" event) with the participant's first look.
+  const std::string token = token_from_redirect(manager.start("uid=watch-clock&scenario=warehouse"));
+  REQUIRE(token.size() == 32);
+  REQUIRE(manager.wait_for_state(token, "running"));
+  const auto row = manager.row_for_token(token);
+  REQUIRE(row);
+  const std::filesystem::path events_file = std::filesystem::path(row->data_path) / "events.jsonl";
+
+  // The researcher opens the session before the participant: the session records the watcher's connect
+  // (the relay's PROXY line marked it view-only) and no timer.
+  WsRfbBridge watch_bridge(watch_url(manager, token), with_authorization(kBearer));
+  RfbTestClient watcher("127.0.0.1", watch_bridge.port());
+  REQUIRE(watcher.wait_for_updates(1, 20s));
+  REQUIRE(eventually(
+      [&] {
+        watcher.pump_until([] { return false; }, 50ms);
+        return index_of(read_events(events_file), "client", "connect") >= 0;
+      },
+      20s));
+  watcher.pump_until([] { return false; }, 1s);  // a few more ticks, in which a started clock would show
+  const auto watched = read_events(events_file);
+  INFO("events.jsonl while only the watcher is there:\n" << read_text(events_file));
+  const int watcher_connect = index_of(watched, "client", "connect");
+  REQUIRE(watcher_connect >= 0);
+  CHECK(watched[static_cast<std::size_t>(watcher_connect)].value("role", "") == "watcher");
+  CHECK(index_of(watched, "timer") < 0);
+  CHECK(index_of(watched, "task", "started") < 0);
+
+  // Then the participant: the clock starts at its connect.
+  WsRfbBridge participant_bridge(manager.ws_url(token));
+  RfbTestClient participant("127.0.0.1", participant_bridge.port());
+  REQUIRE(participant.wait_for_updates(1, 20s));
+  REQUIRE(eventually(
+      [&] {
+        watcher.pump_until([] { return false; }, 25ms);
+        participant.pump_until([] { return false; }, 25ms);
+        return index_of(read_events(events_file), "timer", "started") >= 0;
+      },
+      20s));
+  const auto events = read_events(events_file);
+  INFO("events.jsonl:\n" << read_text(events_file));
+  REQUIRE(index_of(events, "client", "connect") == watcher_connect);
+  const int participant_connect = index_of(events, "client", "connect", watcher_connect + 1);
+  REQUIRE(participant_connect > watcher_connect);
+  const auto& joined = events[static_cast<std::size_t>(participant_connect)];
+  CHECK_FALSE(joined.contains("role"));  // a participant's connect is written as it always was
+  const int timer = index_of(events, "timer", "started");
+  CHECK(timer > participant_connect);
+  CHECK(index_of(events, "timer", "started", timer + 1) < 0);  // once
+  CHECK(events[static_cast<std::size_t>(timer)]["tick"] == joined["tick"]);
+  CHECK(events[static_cast<std::size_t>(timer)]["tick"].get<std::uint64_t>() >
+        events[static_cast<std::size_t>(watcher_connect)]["tick"].get<std::uint64_t>());
+  CHECK(manager.state_of(token) == "running");
 }
