@@ -130,7 +130,7 @@ TEST_CASE("the overall and per-scenario tables give the rates and statistics of 
   const std::string md = read_text(out / "report.md");
   CHECK_THAT(md, Catch::Contains("| scenario lab | 3 | 0 | 33.3 |"));
   // The paper's figures under the groups, in the columns of the rates they compare with.
-  CHECK_THAT(md, Catch::Contains("| SEAN-EP paper | 372 |  | 6.18 |  | 2.15 |  | 52.4 | 84.9 |  |  |  |  |\n"));
+  CHECK_THAT(md, Catch::Contains("| SEAN-EP paper | 372 |  | 6.18 |  | 2.15 |  | 52.4 | 84.9 |  |  |  |  |  |\n"));
   const std::string html = read_text(out / "report.html");
   CHECK_THAT(html, Catch::Contains("<td>scenario warehouse</td>"));
   CHECK_THAT(html, Catch::Contains("<svg"));

@@ -53,6 +53,9 @@ const std::vector<Rate>& summary_rates() {
        std::nullopt},
       {"robot_gap_within_1_2", "robot within 1.2 m (surfaces)", [](const M& m) { return m.robot_gap_within_1_2; },
        std::nullopt},
+      // Issue 19's target for the robot's own conduct (bench_nav: "robot-caused intimate-space intrusions").
+      {"robot_caused_intimate", "robot itself came within 0.45 m",
+       [](const M& m) { return m.social && m.social->robot_intimate_intrusions > 0; }, std::nullopt},
       {"avatar_pushed_robot", "avatar pushed the robot", [](const M& m) { return m.avatar_pushed_robot; },
        std::nullopt},
       {"avatar_person_collision", "avatar-person collision", [](const M& m) { return m.avatar_person_collisions > 0; },

@@ -25,8 +25,8 @@ struct Rate {
 };
 
 /// The rates, in order: timed_out, completed, never_moved, found_robot, robot_within_0_45,
-/// robot_within_1_2, robot_gap_within_0_45, robot_gap_within_1_2, avatar_pushed_robot,
-/// avatar_person_collision.
+/// robot_within_1_2, robot_gap_within_0_45, robot_gap_within_1_2, robot_caused_intimate,
+/// avatar_pushed_robot, avatar_person_collision.
 const std::vector<Rate>& summary_rates();
 
 /// Sessions the SEAN-EP paper's rates (Rate::paper_percent) are over (docs/sources.md).

@@ -35,6 +35,21 @@ std::function<Value(const M&)> robot(Get get) {
   };
 }
 
+// A social_metrics measure (bench_nav's): empty without a robot; `none` (a distance or time that never
+// happened) is empty too, never the sentinel.
+std::function<Value(const M&)> social_distance(double sim::SocialMetrics::*member) {
+  return [member](const M& m) -> Value {
+    if (!m.social) return {};
+    const double v = (*m.social).*member;
+    return v >= sim::SocialMetrics::kNoDistance ? Value() : Value(v);
+  };
+}
+
+template <typename Get>
+std::function<Value(const M&)> social(Get get) {
+  return [get](const M& m) -> Value { return m.social ? get(*m.social) : Value(); };
+}
+
 Column column(const char* name, const char* unit, const char* meaning, std::function<Value(const M&)> value,
               bool summarized = false, bool shown = false) {
   return Column{name, unit, meaning, std::move(value), summarized, shown};
@@ -146,6 +161,34 @@ std::vector<Column> make_columns() {
              robot([](const RobotMetrics& r) { return r.mean_abs_jerk; }), true),
       column("robot_time_to_goal", "s", "time of the robot's first arrival",
              [](const M& m) { return maybe(m.time_to_goal); }, true, true),
+      // bench_nav's measures of the robot's own doing (simulator/robot/social_metrics.hpp).
+      column("robot_min_distance_moving_toward", "m", "closest person while the robot moved toward them",
+             social_distance(&sim::SocialMetrics::min_distance_robot_approaching), true, true),
+      column("robot_min_person_gap", "m", "closest surface gap to a person or the avatar",
+             social_distance(&sim::SocialMetrics::min_gap), true),
+      column("robot_personal_intrusions", "", "episodes of someone within 1.2 m of the robot (centres)",
+             social([](const sim::SocialMetrics& s) { return count(s.personal_intrusions); }), true),
+      column("robot_caused_personal_intrusions", "", "of those, the robot's doing",
+             social([](const sim::SocialMetrics& s) { return count(s.robot_personal_intrusions); }), true, true),
+      column("robot_intimate_intrusions", "", "episodes of someone within 0.45 m of the robot (centres)",
+             social([](const sim::SocialMetrics& s) { return count(s.intimate_intrusions); }), true),
+      column("robot_caused_intimate_intrusions", "", "of those, the robot's doing",
+             social([](const sim::SocialMetrics& s) { return count(s.robot_intimate_intrusions); }), true, true),
+      column("robot_intrusion_share", "%", "robot-caused share of the personal-space intrusions",
+             social([](const sim::SocialMetrics& s) {
+               return s.personal_intrusions > 0 ? Value(100.0 * s.robot_intrusion_share()) : Value();
+             }),
+             true),
+      column("robot_min_ttc_moving_toward", "s", "least time to collision while the robot moved toward them",
+             social([](const sim::SocialMetrics& s) {
+               return s.min_ttc_robot_approaching >= sim::SocialMetrics::kNoTime ? Value()
+                                                                                 : Value(s.min_ttc_robot_approaching);
+             }),
+             true),
+      column("robot_path_irregularity_per_m", "rad/m", "heading turned beyond the straight line's, per metre",
+             social([](const sim::SocialMetrics& s) { return Value(s.path_irregularity_per_m); }), true),
+      column("robot_time_stopped", "s", "time with the robot slower than 0.01 m/s, sample to next sample",
+             social([](const sim::SocialMetrics& s) { return Value(s.time_stopped); }), true),
   };
 }
 

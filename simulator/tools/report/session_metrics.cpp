@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "social_measures.hpp"
+
 namespace rfbsim::report {
 
 namespace {
@@ -121,6 +123,7 @@ SessionMetrics session_metrics(const sim::SessionLog& log, const SampledSession&
   count_events(log, window, out.measured_from, out);
   measure_avatar(measured, out);
   out.robot = robot_metrics(measured);
+  out.social = social_measures(measured);
   return out;
 }
 

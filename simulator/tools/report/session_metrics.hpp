@@ -9,6 +9,7 @@
 #include <string>
 
 #include "record/session_log.hpp"
+#include "robot/social_metrics.hpp"
 #include "robot_metrics.hpp"
 #include "session_samples.hpp"
 
@@ -73,6 +74,10 @@ struct SessionMetrics {
 
   // The robot's social-navigation measures; none without a robot or samples.
   std::optional<RobotMetrics> robot;
+  /// bench_nav's measures of the robot's own behaviour (social_measures: who caused each intrusion, its
+  /// closest approach while moving toward someone, time to collision, path irregularity, time stopped);
+  /// none without a robot or samples.
+  std::optional<sim::SocialMetrics> social;
   std::optional<double> time_to_goal;  ///< s from measured_from: the first robot event with state arrived
 };
 
