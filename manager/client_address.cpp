@@ -4,6 +4,7 @@
 
 #include <arpa/inet.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cstring>
 
@@ -79,6 +80,14 @@ std::string address_text(const AddressRange& address) {
     ::inet_ntop(AF_INET6, address.bytes.data(), text, sizeof text);
   }
   return text;
+}
+
+std::string limit_key(std::string_view address) {
+  auto parsed = parse_address(address);
+  if (!parsed) return std::string(address);
+  if (is_mapped_v4(parsed->bytes)) return address_text(*parsed);
+  std::fill(parsed->bytes.begin() + 8, parsed->bytes.end(), std::uint8_t{0});
+  return address_text(*parsed) + "/64";
 }
 
 std::string client_address(std::string_view peer, std::string_view forwarded_for,

@@ -35,6 +35,12 @@ bool range_contains(const AddressRange& range, const AddressRange& address);
 /// machine always counts under one key.
 std::string address_text(const AddressRange& address);
 
+/// The key a client counts under in the abuse limits: an IPv4 address as itself, an IPv6 address as its
+/// /64 ("2001:db8:1:2::/64"). An ISP hands each subscriber at least a /64, so one machine can draw a fresh
+/// IPv6 address per connection from it: counting per address would give it 2^64 allowances. Text that is no
+/// address is returned as it is.
+std::string limit_key(std::string_view address);
+
 /// The client's address: `peer` (as the socket reports it), unless `peer` is in `trusted` and
 /// `forwarded_for` (the X-Forwarded-For header, "" if absent) names one. Unparseable entries stop the walk
 /// (the peer's view is kept). Returns canonical text.

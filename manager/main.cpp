@@ -103,14 +103,15 @@ std::vector<std::filesystem::path> scenario_search_dirs() {
 // every session of it would fail. Warns where a name is not found or an explicit max_duration cuts tasks.
 void learn_scenarios(ManagerConfig& config) {
   namespace manager = rfbsim::manager;
-  if (config.session_kind != manager::SessionKind::kSimRfb) return;  // a legacy program's scenarios are its own
-  // sim_rfb runs in its session's folder: a FILE relative to where the manager was started must reach it whole.
+  // Every session program runs in its session's folder: a FILE relative to where the manager was started
+  // must reach it whole (sim_rfb's --scenario, a legacy program's {scenario}).
   for (std::string& entry : config.scenarios) {
     const std::size_t eq = entry.find('=');
     if (eq != std::string::npos && std::filesystem::path(entry.substr(eq + 1)).is_relative()) {
       entry = entry.substr(0, eq + 1) + std::filesystem::absolute(entry.substr(eq + 1)).string();
     }
   }
+  if (config.session_kind != manager::SessionKind::kSimRfb) return;  // a legacy program's scenarios are its own
   std::string error;
   std::vector<std::string> missing;
   config.scenario_facts = manager::load_scenario_facts(config.scenarios, scenario_search_dirs(), error, missing);

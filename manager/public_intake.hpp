@@ -81,12 +81,14 @@ class PublicIntake {
     pause_.cancel();
   }
 
-  /// The address limits and logs use: the peer, or the participant a trusted front end names.
+  /// The address limits and logs use: the peer, or the participant a trusted front end names; an IPv6
+  /// address as its /64 (limit_key).
   std::string client_address_of(const ConnectionPtr& con) {
     boost::system::error_code ec;
     const auto remote = con->get_raw_socket().lowest_layer().remote_endpoint(ec);
     if (ec) return "unknown";
-    return client_address(remote.address().to_string(), con->get_request_header("X-Forwarded-For"), trusted_proxies_);
+    return limit_key(
+        client_address(remote.address().to_string(), con->get_request_header("X-Forwarded-For"), trusted_proxies_));
   }
 
   /// Public connections open now, and from how many addresses (for /metrics).
@@ -150,7 +152,7 @@ class PublicIntake {
     const auto parsed = parse_address(peer);
     const bool trusted = parsed && std::any_of(trusted_proxies_.begin(), trusted_proxies_.end(),
                                                [&](const AddressRange& range) { return range_contains(range, *parsed); });
-    const std::string key = trusted ? std::string("trusted proxy") : (parsed ? address_text(*parsed) : peer);
+    const std::string key = trusted ? std::string("trusted proxy") : limit_key(peer);
     const bool allowed = trusted ? limits_.try_open_uncapped(key) : limits_.try_open(key);
     if (!allowed) {
       metrics_.count_rejection(Rejection::kConnectionLimit);

@@ -57,10 +57,8 @@ std::optional<ScenarioFacts> parse_scenario_facts(const std::string& text, const
       return std::nullopt;
     }
     for (const auto& spawn : spawns) {
-      if (!spawn.first.IsScalar() || !is_identifier(spawn.first.Scalar())) {
-        error = where(file, spawn.first, "spawns") + "expected a name (letters, digits, - and _, at most 64)";
-        return std::nullopt;
-      }
+      // A name no link can carry (not an identifier) is sim_rfb's business, not a reason to stop the manager.
+      if (!spawn.first.IsScalar() || !is_identifier(spawn.first.Scalar())) continue;
       facts.spawns.push_back(spawn.first.Scalar());
     }
   }

@@ -359,9 +359,14 @@ void Supervisor::launched(std::int64_t id, LaunchResult result, StartReply reply
   Session* session = table_.by_id(id);
   if (session == nullptr) {  // cannot happen: a session leaves the table only once it has a result
     if (result.process.pid > 0) signal_process_group(result.process.pid, SIGKILL);
+    StartOutcome lost;
+    lost.message = "the session ended as it started";
+    reply(lost);
     return;
   }
   if (!result.error.empty()) {
+    // Failed, also when an administrator or shutdown had begun ending it meanwhile: that it never ran is the
+    // truer record.
     session->state = SessionState::kFailed;
     session->detail = result.error;
     session->ended_at = std::chrono::system_clock::now();
@@ -388,9 +393,9 @@ void Supervisor::launched(std::int64_t id, LaunchResult result, StartReply reply
   Runtime& rt = runtime(id);
   if (result.process.ready_fd >= 0) rt.ready_pipe.assign(result.process.ready_fd);
   if (session->state == SessionState::kEnding) {
-    // Ended while it started (shutdown, an administrator, the start deadline, the index): the stop timer is
-    // already armed, and now there is a process for it.
-    signal_process_group(session->pid, config_.stop_grace.count() == 0 ? SIGKILL : SIGTERM);
+    // Ended while it started (shutdown, an administrator, the start deadline, the index): now there is a
+    // process to stop, with the whole grace period from now.
+    stop_process(*session);
   } else if (result.process.ready_fd >= 0) {
     watch_ready_pipe(*session);
   } else {
@@ -552,12 +557,18 @@ void Supervisor::begin_end(Session& session, SessionState end_as, const std::str
   rt.start_deadline.cancel();
   rt.expiry.cancel();
   rt.idle.cancel();
+  // A session whose process is still being started gets stopped once its pid is known (launched()).
+  if (session.pid > 1) stop_process(session);
+}
+
+void Supervisor::stop_process(Session& session) {
   if (config_.stop_grace.count() == 0) {
     signal_process_group(session.pid, SIGKILL);
     return;
   }
   signal_process_group(session.pid, SIGTERM);
   const std::int64_t id = session.id;
+  Runtime& rt = runtime(id);
   rt.stop.expires_after(config_.stop_grace);
   rt.stop.async_wait([this, id](const boost::system::error_code& ec) {
     Session* s = table_.by_id(id);

@@ -96,6 +96,8 @@ class Supervisor {
   struct Runtime;
 
   void begin_end(Session& session, SessionState end_as, const std::string& detail);
+  // SIGTERM to the session's process group, then SIGKILL after the grace period (at once without one).
+  void stop_process(Session& session);
   // A start that failed before it had a slot: recorded as failed, and the participant told.
   void fail_start(Session session, const std::string& error, const StartReply& reply);
   // The launcher's result for session `id`, back on the I/O thread: the process joins the session, or the

@@ -135,7 +135,7 @@ std::vector<Setting> settings(RobotParams& p) {
       {"dwa", "people_clearance", &p.dwa.people_clearance, 0.0, 5.0},
       {"dwa", "people_horizon", &p.dwa.people_horizon, 0.0, 10.0},
       {"dwa", "people_personal_clearance", &p.dwa.people_personal_clearance, 0.0, 5.0},
-      {"dwa", "people_walking_speed", &p.dwa.people_walking_speed, 0.0, 5.0},
+      {"dwa", "people_walking_speed", &p.dwa.people_walking_speed, 0.05, 5.0},
       {"dwa", "oscillation_reset_dist", &p.dwa.oscillation_reset_dist, 0.0, 10.0},
       {"dwa", "oscillation_reset_angle", &p.dwa.oscillation_reset_angle, 0.0, 10.0},
   };

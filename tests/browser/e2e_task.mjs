@@ -55,11 +55,15 @@ function checkAgainstData(folder, session, events, layout) {
   // Followed: the samples between the follow step's start and its end within its range add up to its duration.
   const hz = session.trajectory_hz;
   const during = samples.filter((s) => s.tick > started(1).tick && s.tick <= done(1).tick);
-  const near = during.filter((s) => distance(s.avatar, s.robot) <= steps[1].distance).length;
+  const inRange = during.map((s) => distance(s.avatar, s.robot) <= steps[1].distance);
+  const near = inRange.filter(Boolean).length;
+  // The monitor counts every tick in range; the samples see one tick in six, so each stretch in range may
+  // show up to one sample interval short at its ends.
+  const stretches = inRange.filter((isIn, i) => isIn && (i === 0 || !inRange[i - 1])).length;
   const followed = (done(1).tick - started(1).tick) / session.tick_hz;
   check(followed >= steps[1].duration - 1e-6,
         `follow_robot was done ${followed.toFixed(2)} s after it started; it asks ${steps[1].duration} s`);
-  check(near / hz >= steps[1].duration - 2 / hz,
+  check(near / hz >= steps[1].duration - (stretches + 1) / hz,
         `the trajectories have the avatar within ${steps[1].distance} m of the robot for only ${(near / hz).toFixed(1)} s ` +
         `of the follow step (needs ${steps[1].duration} s)`);
   // Reached: the avatar at the marker.

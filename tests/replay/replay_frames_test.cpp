@@ -5,7 +5,8 @@
 //
 // Which tick a served picture shows: sim_rfb draws after its steps at the frame rate, at whatever tick the
 // wall clock reached, and the stream does not say which. So pictures are taken only while the world is still
-// (the tutorial: no robot, no pedestrians; keys released; the HUD's clock between two seconds). /status.json
+// (tests/replay/scenarios/still_lab.yaml: the tutorial's lab without robot, pedestrians or a task clock on
+// the HUD; keys released). /status.json
 // gives the tick and the count of frames rendered; sim_rfb renders a frame only when it would look different
 // from the last one (FramePainter), so an unchanged count across a span of ticks says every tick of that span
 // looks as the picture served, and any one of them names it. No hook in sim_rfb is needed.
@@ -36,7 +37,7 @@ constexpr int kHeight = 240;
 
 // The tolerances, per pair of RGB pictures of the same moment (docs/replay.md, "Compared with what was
 // served"). The video is H.264 (libx264 CRF 23, 4:2:0), which softens edges and halves the colour resolution,
-// the HUD's text and the desks' outlines most. Measured at 320x240 on the tutorial: the video's frame against
+// the HUD's text and the desks' outlines most. Measured at 320x240 in this lab (with the tutorial's HUD text then): the video's frame against
 // the Raw capture MAD 1.9-2.9, PSNR 33-36 dB; the worst case is a frame coded alone (a keyframe, every 2 s):
 // the capture itself through libx264 with the replay's settings loses MAD 2.7-3.6, PSNR 31-33 dB. The
 // browser's Tight JPEG (the server's quality 80, 4:2:0) adds its own loss: MAD 2.5-3.9, PSNR 32-35 dB against
@@ -200,7 +201,7 @@ TEST_CASE("the replay's video shows the frames sim_rfb served at the same ticks 
   std::vector<Still> stills;
   {
     test::SimProcess sim(test::sim_rfb_path(),
-                         {"--port", "0", "--scenario", "tutorial", "--data-dir", dir.string(), "--width",
+                         {"--port", "0", "--scenario", RFBSIM_STILL_SCENARIO, "--data-dir", dir.string(), "--width",
                           std::to_string(kWidth), "--height", std::to_string(kHeight), "--uid", "p-frames"});
     // The participant sees the server's pixels exactly; a second viewer gets Tight JPEG at the server's
     // quality, as the participant's browser does.
@@ -212,9 +213,9 @@ TEST_CASE("the replay's video shows the frames sim_rfb served at the same ticks 
 
     // Three moments far apart in the picture: the start, a metre or so further on, then turned left.
     stills.push_back(capture_still("start", sim.port(), viewers));
-    viewers.hold_key('w', std::chrono::milliseconds(1000));
+    viewers.hold_key('w', std::chrono::milliseconds(1500));
     stills.push_back(capture_still("walked", sim.port(), viewers));
-    viewers.hold_key('a', std::chrono::milliseconds(700));
+    viewers.hold_key('a', std::chrono::milliseconds(1000));
     stills.push_back(capture_still("turned", sim.port(), viewers));
 
     const int status = sim.stop(SIGTERM);
@@ -236,6 +237,7 @@ TEST_CASE("the replay's video shows the frames sim_rfb served at the same ticks 
   REQUIRE(run.exit_code == 0);
 
   std::vector<std::uint64_t> indices;
+  std::vector<sim::TrajectoryRow> still_poses;  // the avatar's pose at each still
   for (const Still& still : stills) {
     INFO(still.name << ": ticks " << still.first_tick << ".." << still.last_tick);
     REQUIRE(still.tick() < *log.meta.end_tick);
@@ -253,7 +255,13 @@ TEST_CASE("the replay's video shows the frames sim_rfb served at the same ticks 
       CHECK(row->y == rows.front()->y);
       CHECK(row->yaw == rows.front()->yaw);
     }
+    still_poses.push_back(*rows.front());
   }
+  // The keys did move the avatar between the stills (a stalled sim_rfb could apply a press and its release
+  // in one tick): the three moments are different pictures.
+  REQUIRE(still_poses.size() == 3);
+  CHECK(std::hypot(still_poses[1].x - still_poses[0].x, still_poses[1].y - still_poses[0].y) > 0.5);
+  CHECK(std::abs(still_poses[2].yaw - still_poses[1].yaw) > 0.3);
   const std::vector<Pixels> frames = decoded_frames(video, indices, dir.parent_path() / "served_frames.rgb");
 
   for (std::size_t i = 0; i < stills.size(); ++i) {

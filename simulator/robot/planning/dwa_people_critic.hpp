@@ -23,7 +23,7 @@ class PeopleCritic final : public DwaCritic {
   /// that a rollout's points up to its `end` span; `personal_clearance` m between the bodies within which
   /// the robot may not close in on a person walking at least `walking_speed` m/s (0: no such rule).
   PeopleCritic(double robot_radius, double clearance, double horizon, double sim_time, double personal_clearance = 0.0,
-               double walking_speed = 0.1)
+               double walking_speed = 0.5)
       : robot_radius_(robot_radius), clearance_(clearance), horizon_(horizon), sim_time_(sim_time),
         personal_clearance_(personal_clearance), walking_speed_(walking_speed) {}
 

@@ -261,6 +261,23 @@ TEST_CASE("X-Forwarded-For counts per forwarded address only from a trusted prox
     CHECK(manager.metric("rfbsim_rejections_total{reason=\"rate_limited\"}") == 5);
   }
 
+  SECTION("behind a trusted proxy an IPv6 participant's whole /64 shares one bucket") {
+    auto flags = tight;
+    flags.insert(flags.end(), {"--trusted-proxies", "127.0.0.1"});
+    ManagerUnderTest manager(data.path(), with_small_sessions(flags));
+    const auto from = [&](const std::string& address) {
+      return rfbsim::test::net::http_request(
+                 manager.port(),
+                 abuse::raw_request("GET", "/start?no-uid=1", manager.port(), {{"X-Forwarded-For", address}}))
+          .status;
+    };
+    // A fresh address from the same /64 each time does not buy a fresh allowance; the next /64 has its own.
+    CHECK(from("2001:db8:1:2::1") == 400);
+    CHECK(from("2001:db8:1:2::2") == 400);
+    CHECK(from("2001:db8:1:2:ffff::3") == 429);
+    CHECK(from("2001:db8:1:3::1") == 400);
+  }
+
   SECTION("from anyone else the header is ignored: one address, one bucket") {
     ManagerUnderTest manager(data.path(), with_small_sessions(tight));
     CHECK(forwarded_start(manager, 1).status == 400);

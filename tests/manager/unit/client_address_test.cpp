@@ -65,3 +65,15 @@ TEST_CASE("the rightmost untrusted entry is the client; made-up entries to its l
   CHECK(client_address("10.0.0.5", "203.0.113.9, not-an-address", trusted) == "10.0.0.5");
   CHECK(client_address("::ffff:10.0.0.5", " 2001:db8::7 ", trusted) == "2001:db8::7");
 }
+
+TEST_CASE("an IPv4 client counts as itself, an IPv6 client as its /64") {
+  using rfbsim::manager::limit_key;
+  CHECK(limit_key("203.0.113.9") == "203.0.113.9");
+  CHECK(limit_key("::ffff:203.0.113.9") == "203.0.113.9");
+  CHECK(limit_key("2001:db8:1:2:aaaa:bbbb:cccc:dddd") == "2001:db8:1:2::/64");
+  // Two addresses a machine draws from its one /64 share a key; the neighbouring /64 does not.
+  CHECK(limit_key("2001:db8:1:2::1") == limit_key("2001:db8:1:2:ffff::9"));
+  CHECK(limit_key("2001:db8:1:3::1") != limit_key("2001:db8:1:2::1"));
+  CHECK(limit_key("::1") == "::/64");
+  CHECK(limit_key("unknown") == "unknown");
+}
