@@ -6,7 +6,9 @@
 //
 // Poses are quantised (0.1 mm, 0.1 mrad) before hashing, so that the digest names behaviour, not the last bit
 // of a double. On x86-64 without -march flags the compiler contracts nothing into FMA, so optimisation levels
-// agree; if a build type ever disagrees, give it its own digest here rather than loosening the check.
+// agree: RelWithDebInfo (CI), Release (-O3) and the Debug ASan/UBSan build of scripts/test.sh --sanitize gave
+// this one digest (2026-11-26, GCC 12). If a build type ever disagrees, give it its own digest here rather
+// than loosening the check.
 #include <catch2/catch.hpp>
 
 #include <cinttypes>
