@@ -15,12 +15,14 @@
 #include <vector>
 
 #include "process_launcher.hpp"
+#include "reap_child.hpp"
 #include "scratch_dir.hpp"
 
 using rfbsim::manager::LaunchJob;
 using rfbsim::manager::LaunchResult;
 using rfbsim::manager::ProcessLauncher;
 using rfbsim::manager::run_launch;
+using rfbsim::test::reap_child;
 using rfbsim::test::ScratchDir;
 
 namespace {
@@ -35,16 +37,6 @@ LaunchJob shell_job(const std::string& folder, const std::string& script) {
   job.spec.log_file = folder + "/session.log";
   job.spec.ready_pipe = false;
   return job;
-}
-
-int reap(pid_t pid) {
-  int status = 0;
-  pid_t got = 0;
-  do {
-    got = ::waitpid(pid, &status, 0);
-  } while (got < 0 && errno == EINTR);
-  REQUIRE(got == pid);
-  return status;
 }
 
 }  // namespace
@@ -66,7 +58,7 @@ TEST_CASE("a launch makes the session's folder and starts its program off the ca
     CHECK(result.error.empty());
     REQUIRE(result.process.pid > 1);
     CHECK(std::filesystem::is_directory(folder));
-    const int status = reap(result.process.pid);
+    const int status = reap_child(result.process.pid);
     CHECK(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 7);
   }
@@ -114,6 +106,6 @@ TEST_CASE("launches run one after another, in the order they were queued") {
   CHECK(order == std::vector<int>{0, 1, 2});
   for (const pid_t pid : started) {
     REQUIRE(pid > 1);
-    reap(pid);
+    reap_child(pid);
   }
 }

@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "reap_child.hpp"
 #include "scoped_env.hpp"
 #include "scratch_dir.hpp"
 #include "session_process.hpp"
@@ -33,6 +34,7 @@ using rfbsim::manager::signal_process_group;
 using rfbsim::manager::spawn_session_process;
 using rfbsim::manager::SpawnedProcess;
 using rfbsim::manager::SpawnSpec;
+using rfbsim::test::reap_child;
 using rfbsim::test::ScratchDir;
 
 namespace {
@@ -47,21 +49,10 @@ SpawnSpec shell(const ScratchDir& dir, const std::string& script) {
   return spec;
 }
 
-// Waits for `pid` and returns its wait status.
-int reap(pid_t pid) {
-  int status = 0;
-  pid_t got = 0;
-  do {
-    got = ::waitpid(pid, &status, 0);
-  } while (got < 0 && errno == EINTR);
-  REQUIRE(got == pid);
-  return status;
-}
-
 // Runs the spec to its end; returns the wait status and closes the ready pipe.
 int run_to_end(const SpawnSpec& spec) {
   const SpawnedProcess process = spawn_session_process(spec);
-  const int status = reap(process.pid);
+  const int status = reap_child(process.pid);
   if (process.ready_fd >= 0) ::close(process.ready_fd);
   return status;
 }
@@ -119,7 +110,7 @@ TEST_CASE("a session process leads its own group, logs its output and reports re
   CHECK(process_group_alive(process.pid));
 
   REQUIRE(signal_process_group(process.pid, SIGKILL));
-  const int status = reap(process.pid);
+  const int status = reap_child(process.pid);
   CHECK(WIFSIGNALED(status));
   CHECK(WTERMSIG(status) == SIGKILL);
   CHECK(dir.read("session.log") == "out\nerr\n");
@@ -133,7 +124,7 @@ TEST_CASE("the ready pipe's read end is non-blocking, close-on-exec and ends whe
   REQUIRE(process.ready_fd >= 0);
   CHECK((::fcntl(process.ready_fd, F_GETFL) & O_NONBLOCK) != 0);
   CHECK((::fcntl(process.ready_fd, F_GETFD) & FD_CLOEXEC) != 0);
-  const int status = reap(process.pid);
+  const int status = reap_child(process.pid);
   CHECK(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 0);
   // End of file, not "would block": the child held the only write end.
@@ -167,7 +158,7 @@ TEST_CASE("no descriptor of the parent leaks into the session") {
     spec.ready_pipe = false;
     const SpawnedProcess process = spawn_session_process(spec);
     CHECK(process.ready_fd == -1);
-    reap(process.pid);
+    reap_child(process.pid);
     CHECK(dir.read("session.log") == "0\n1\n2\n3\n");
   }
   SECTION("stdin is /dev/null, stdout and stderr the log, fd 3 a pipe") {
@@ -285,11 +276,11 @@ TEST_CASE("signalling the process group reaches the session's own children") {
   CHECK(::getpgid(grandchild) == process.pid);
 
   REQUIRE(signal_process_group(process.pid, SIGTERM));
-  const int status = reap(process.pid);
+  const int status = reap_child(process.pid);
   CHECK(WIFSIGNALED(status));
   CHECK(WTERMSIG(status) == SIGTERM);
   // The grandchild, orphaned, came to us as the subreaper: it too died of SIGTERM.
-  const int grandchild_status = reap(grandchild);
+  const int grandchild_status = reap_child(grandchild);
   CHECK(WIFSIGNALED(grandchild_status));
   CHECK(WTERMSIG(grandchild_status) == SIGTERM);
 
@@ -322,7 +313,7 @@ TEST_CASE("process_start_ticks reads /proc and knows no dead process") {
   CHECK(process_start_ticks(::getpid()) == start_ticks_from_proc(::getpid()));
 
   REQUIRE(signal_process_group(process.pid, SIGKILL));
-  reap(process.pid);
+  reap_child(process.pid);
   ::close(process.ready_fd);
   CHECK_FALSE(process_start_ticks(process.pid));
   CHECK_FALSE(process_group_alive(process.pid));
@@ -344,7 +335,7 @@ TEST_CASE("process_start_ticks copes with spaces and parentheses in the command 
   CHECK(ticks == start_ticks_from_proc(process.pid));
   CHECK(process.start_ticks == start_ticks_from_proc(process.pid));
   REQUIRE(signal_process_group(process.pid, SIGKILL));
-  reap(process.pid);
+  reap_child(process.pid);
   CHECK(no_children_left());
 }
 
@@ -374,10 +365,10 @@ TEST_CASE("a session dies with the process that started it") {
   pid_t session = -1;
   REQUIRE(::read(report[0], &session, sizeof session) == static_cast<ssize_t>(sizeof session));
   ::close(report[0]);
-  CHECK(WIFEXITED(reap(manager)));
+  CHECK(WIFEXITED(reap_child(manager)));
   REQUIRE(session > 0);
   // Orphaned, the session came to us; the parent-death signal killed it.
-  const int status = reap(session);
+  const int status = reap_child(session);
   CHECK(WIFSIGNALED(status));
   CHECK(WTERMSIG(status) == SIGKILL);
   CHECK(no_children_left());
