@@ -6,13 +6,24 @@
 // ROS map_server YAML the map uses (image, resolution, origin, negate, occupied_thresh).
 
 import fs from 'node:fs';
+import { createRequire } from 'node:module';
 import path from 'node:path';
+import { fileURLToPath } from 'node:url';
 
-import { parseYamlSubset } from './yaml_subset.mjs';
+// The yaml package (npm, a devDependency of web/ like playwright-core), from web/node_modules.
+const YAML = createRequire(path.join(path.dirname(fileURLToPath(import.meta.url)), '..', '..', 'web',
+                                     'package.json'))('yaml');
 
 export const GRID_RESOLUTION_M = 0.1;   // the participant plans on cells this size (the map's are 0.05 m)
 
-const readYaml = (file) => parseYamlSubset(fs.readFileSync(file, 'utf8'), file);
+// A YAML file as plain data; a malformed one is an error naming the file (and the line, from the parser).
+function readYaml(file) {
+  try {
+    return YAML.parse(fs.readFileSync(file, 'utf8'));
+  } catch (err) {
+    throw new Error(`${file}: ${err.message}`);
+  }
+}
 
 // A binary PGM (P5, 8-bit) as { width, height, pixels } (row 0 is the top of the image).
 function readPgm(file) {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The scripted participant's pure parts without a browser or simulator: the YAML subset reader, a scenario's
-// layout (a tiny hand-made room: 3 x 3 m, a 0.2 x 1.6 m prop across its lower middle), paths around that prop,
-// and reading a session's data while it is still being written.
+// The scripted participant's pure parts without a browser or simulator: a scenario's layout (a tiny hand-made
+// room: 3 x 3 m, a 0.2 x 1.6 m prop across its lower middle), paths around that prop, and reading a session's
+// data while it is still being written.
 // Usage: node task_participant_parts_test.mjs     Exits 0 when every check passed, 1 otherwise.
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
@@ -11,7 +11,6 @@ import path from 'node:path';
 import { headFor, planPath, segmentClear } from './grid_path.mjs';
 import { loadScenarioLayout } from './scenario_layout.mjs';
 import { SessionTail } from './session_tail.mjs';
-import { parseYamlSubset } from './yaml_subset.mjs';
 
 let failures = 0;
 function check(name, body) {
@@ -25,36 +24,6 @@ function check(name, body) {
 }
 const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'rfbsim-participant-test-'));
 process.on('exit', () => fs.rmSync(dir, { recursive: true, force: true }));
-
-check('YAML: mappings, sequences, flow values over lines, comments, quotes', () => {
-  const doc = parseYamlSubset([
-    'name: room   # a comment',
-    'description: a room, with commas',
-    'spawns:',
-    '  door: [0.5, 0.5, 1.5708]',
-    'landmarks:',
-    '  - name: mark',
-    '    position: door',
-    '    color: "#f2c12e"',
-    'goals: [a, b,',
-    '        c]',
-    'repeat: {count: 3, step: [1.5, -2e-1]}',
-    'flags: [true, null, ~, \'x y\']',
-  ].join('\n'), 'test.yaml');
-  assert.deepEqual(doc, {
-    name: 'room', description: 'a room, with commas', spawns: { door: [0.5, 0.5, 1.5708] },
-    landmarks: [{ name: 'mark', position: 'door', color: '#f2c12e' }], goals: ['a', 'b', 'c'],
-    repeat: { count: 3, step: [1.5, -0.2] }, flags: [true, null, null, 'x y'],
-  });
-});
-
-check('YAML: what it cannot read is an error naming the file and line', () => {
-  assert.throws(() => parseYamlSubset('a: 1\n\tb: 2', 'f.yaml'), /^Error: f\.yaml:2: tab in indentation/);
-  assert.throws(() => parseYamlSubset('a: 1\nthis is not a key', 'f.yaml'), /f\.yaml:2: expected 'key: value'/);
-  assert.throws(() => parseYamlSubset('a: [1, 2', 'f.yaml'), /f\.yaml:1: expected ',' or '\]'/);
-  assert.throws(() => parseYamlSubset('a: |\n  text', 'f.yaml'), /f\.yaml:1: .*block scalars/);
-  assert.throws(() => parseYamlSubset('a:\n    b: 1\n  c: 2', 'f.yaml'), /f\.yaml:3: /);
-});
 
 // The room: a 60 x 60 pixel map at 0.05 m with a one-pixel wall all round; a prop 0.2 m across (x 1.4-1.6)
 // from the floor to y 1.6.
@@ -99,6 +68,12 @@ check('layout: cells, clearance to the walls and the prop, named points', () => 
   assert.deepEqual(layout.point('mark'), { x: 2.5, y: 0.5 });
   assert.deepEqual(layout.reachTarget(0), { x: 2.5, y: 0.5, name: 'mark' });
   assert.throws(() => layout.point('nowhere'), /scenario\.yaml: point '"nowhere"' is not/);
+});
+
+check('layout: a scenario file that is not YAML is an error naming it', () => {
+  const broken = path.join(dir, 'broken.yaml');
+  fs.writeFileSync(broken, 'map: room.yaml\nprops: [1, 2\n');
+  assert.throws(() => loadScenarioLayout(broken), (err) => err.message.startsWith(`${broken}: `));
 });
 
 check('paths: round the prop, with the clearance asked for, or none', () => {
