@@ -6,6 +6,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -31,6 +32,23 @@ std::optional<double> seconds_value(const YAML::Node& node, double low, double h
     return std::nullopt;
   }
   return value;
+}
+
+// `task.<key>` into `out` when present: seconds within [low, high], else false with `error` naming the file,
+// the line and the key.
+bool read_seconds(const YAML::Node& task, const char* key, double low, double high, const std::string& file,
+                  double& out, std::string& error) {
+  const YAML::Node node = task[key];
+  if (!node) return true;
+  const auto value = seconds_value(node, low, high);
+  if (!value) {
+    char range[48];
+    std::snprintf(range, sizeof range, "expected seconds %g..%g", low, high);
+    error = where(file, node, std::string("task.") + key) + range;
+    return false;
+  }
+  out = *value;
+  return true;
 }
 
 }  // namespace
@@ -69,21 +87,9 @@ std::optional<ScenarioFacts> parse_scenario_facts(const std::string& text, const
       return std::nullopt;
     }
     facts.has_task = true;
-    if (const YAML::Node limit = task["time_limit"]) {
-      const auto value = seconds_value(limit, 1.0, 86400.0);
-      if (!value) {
-        error = where(file, limit, "task.time_limit") + "expected seconds 1..86400";
-        return std::nullopt;
-      }
-      facts.time_limit_s = *value;
-    }
-    if (const YAML::Node grace = task["end_grace"]) {
-      const auto value = seconds_value(grace, 0.0, 3600.0);
-      if (!value) {
-        error = where(file, grace, "task.end_grace") + "expected seconds 0..3600";
-        return std::nullopt;
-      }
-      facts.end_grace_s = *value;
+    if (!read_seconds(task, "time_limit", 1.0, 86400.0, file, facts.time_limit_s, error) ||
+        !read_seconds(task, "end_grace", 0.0, 3600.0, file, facts.end_grace_s, error)) {
+      return std::nullopt;
     }
   }
   return facts;
