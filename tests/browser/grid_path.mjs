@@ -3,6 +3,8 @@
 // least a given clearance, keeping out of discs to avoid (people nearby), preferring the middle of an aisle;
 // and where to head next along a path, as far ahead as the way is clear.
 
+import { forEachNeighbour } from './scenario_layout.mjs';
+
 // A binary min-heap of cell indices keyed by a score.
 class MinHeap {
   constructor() {
@@ -125,29 +127,19 @@ export function planPath(layout, from, to, clearance, avoid = []) {
     if (k === goal) {
       break;
     }
-    const cx = k % cols;
-    const cy = Math.floor(k / cols);
-    for (let dy = -1; dy <= 1; dy += 1) {
-      for (let dx = -1; dx <= 1; dx += 1) {
-        const nx = cx + dx;
-        const ny = cy + dy;
-        if (!(dx || dy) || nx < 0 || ny < 0 || nx >= cols || ny >= rows) {
-          continue;
-        }
-        const n = ny * cols + nx;
-        if (!isFree(n)) {
-          continue;
-        }
-        // Longer through narrow cells, so that the path keeps to the middle where there is room.
-        const extra = Math.min(1, (layout.clearance[n] - clearance) / PREFERRED_EXTRA_M);
-        const step = Math.hypot(dx, dy) * (1 + NARROW_COST * (1 - extra));
-        if (cost[k] + step < cost[n]) {
-          cost[n] = cost[k] + step;
-          from_[n] = k;
-          open.push(n, cost[n] + heuristic(n));
-        }
+    forEachNeighbour(k, cols, rows, (n, nx, ny, dx, dy) => {
+      if (!isFree(n)) {
+        return;
       }
-    }
+      // Longer through narrow cells, so that the path keeps to the middle where there is room.
+      const extra = Math.min(1, (layout.clearance[n] - clearance) / PREFERRED_EXTRA_M);
+      const step = Math.hypot(dx, dy) * (1 + NARROW_COST * (1 - extra));
+      if (cost[k] + step < cost[n]) {
+        cost[n] = cost[k] + step;
+        from_[n] = k;
+        open.push(n, cost[n] + heuristic(n));
+      }
+    });
   }
   if (cost[goal] === Infinity) {
     return null;

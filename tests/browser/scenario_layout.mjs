@@ -14,6 +14,22 @@ import { fileURLToPath } from 'node:url';
 const YAML = createRequire(path.join(path.dirname(fileURLToPath(import.meta.url)), '..', '..', 'web',
                                      'package.json'))('yaml');
 
+// Calls visit(n, nx, ny, dx, dy) for each of cell k's eight neighbours inside a cols x rows grid (cells are
+// numbered row by row).
+export function forEachNeighbour(k, cols, rows, visit) {
+  const cx = k % cols;
+  const cy = Math.floor(k / cols);
+  for (let dy = -1; dy <= 1; dy += 1) {
+    for (let dx = -1; dx <= 1; dx += 1) {
+      const nx = cx + dx;
+      const ny = cy + dy;
+      if ((dx || dy) && nx >= 0 && ny >= 0 && nx < cols && ny < rows) {
+        visit(ny * cols + nx, nx, ny, dx, dy);
+      }
+    }
+  }
+}
+
 export const GRID_RESOLUTION_M = 0.1;   // the participant plans on cells this size (the map's are 0.05 m)
 
 // A YAML file as plain data; a malformed one is an error naming the file (and the line, from the parser).
@@ -85,24 +101,15 @@ function clearanceField(blocked, cols, rows, resolution) {
   while (queue.length > 0) {
     const next = [];
     for (const k of queue) {
-      const cx = k % cols;
-      const cy = Math.floor(k / cols);
-      for (let dy = -1; dy <= 1; dy += 1) {
-        for (let dx = -1; dx <= 1; dx += 1) {
-          const nx = cx + dx;
-          const ny = cy + dy;
-          if ((dx || dy) && nx >= 0 && ny >= 0 && nx < cols && ny < rows) {
-            const n = ny * cols + nx;
-            const d = Math.hypot(nx - siteX[k], ny - siteY[k]);
-            if (d < distance[n] - 1e-9) {
-              distance[n] = d;
-              siteX[n] = siteX[k];
-              siteY[n] = siteY[k];
-              next.push(n);
-            }
-          }
+      forEachNeighbour(k, cols, rows, (n, nx, ny) => {
+        const d = Math.hypot(nx - siteX[k], ny - siteY[k]);
+        if (d < distance[n] - 1e-9) {
+          distance[n] = d;
+          siteX[n] = siteX[k];
+          siteY[n] = siteY[k];
+          next.push(n);
         }
-      }
+      });
     }
     queue = next;
   }
