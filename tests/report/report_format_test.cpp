@@ -45,11 +45,11 @@ TEST_CASE("HTML and Markdown escaping leave no markup a string could start") {
   CHECK(markdown_escape("p017") == "p017");
 }
 
-TEST_CASE("the command line takes one data folder, an optional out folder, and help") {
+TEST_CASE("the command line takes one or more data folders, an optional out folder, and help") {
   CliError error;
   auto options = parse_cli({"data"}, error);
   REQUIRE(options.has_value());
-  CHECK(options->data_dir == "data");
+  CHECK(options->data_dirs == std::vector<std::filesystem::path>{"data"});
   CHECK(options->out_dir == std::filesystem::path("data") / "report");
   options = parse_cli({"--out", "elsewhere", "data"}, error);
   REQUIRE(options.has_value());
@@ -59,19 +59,25 @@ TEST_CASE("the command line takes one data folder, an optional out folder, and h
   CHECK(options->out_dir == "x");
   options = parse_cli({"--", "-odd-name"}, error);
   REQUIRE(options.has_value());
-  CHECK(options->data_dir == "-odd-name");
+  CHECK(options->data_dirs == std::vector<std::filesystem::path>{"-odd-name"});
+  // Several hosts' folders: the report goes to the first one's report/ unless --out says otherwise.
+  options = parse_cli({"h1", "h2", "store"}, error);
+  REQUIRE(options.has_value());
+  CHECK(options->data_dirs == std::vector<std::filesystem::path>{"h1", "h2", "store"});
+  CHECK(options->out_dir == std::filesystem::path("h1") / "report");
   options = parse_cli({"data", "--help"}, error);
   REQUIRE(options.has_value());
   CHECK(options->help);
 
   CHECK_FALSE(parse_cli({}, error).has_value());
   CHECK(error.message == "DATA_DIR is missing");
-  CHECK_FALSE(parse_cli({"a", "b"}, error).has_value());
+  CHECK_FALSE(parse_cli({"a", ""}, error).has_value());
+  CHECK(error.message == "a DATA_DIR is empty");
   CHECK_FALSE(parse_cli({"data", "--out"}, error).has_value());
   CHECK(error.message == "--out needs a folder");
   CHECK_FALSE(parse_cli({"data", "--verbose"}, error).has_value());
   CHECK(error.message == "unknown option '--verbose'");
-  CHECK_THAT(usage_text(), Catch::Contains("sim_report DATA_DIR [--out DIR]"));
+  CHECK_THAT(usage_text(), Catch::Contains("sim_report DATA_DIR [DATA_DIR...] [--out DIR]"));
 }
 
 TEST_CASE("the progress bar redraws one line on a terminal and prints a line per tenth in a log") {

@@ -11,6 +11,7 @@
 #include "progress_line.hpp"
 #include "replay_cli.hpp"
 #include "replay_job.hpp"
+#include "session_lookup.hpp"
 
 int main(int argc, char** argv) {
   using namespace rfbsim::replay;
@@ -26,11 +27,23 @@ int main(int argc, char** argv) {
     return 0;
   }
 
+  // --data-dir: find the one session the uid or id names across the hosts' folders.
+  ReplayOptions chosen = *options;
+  if (!chosen.data_dirs.empty()) {
+    const LookupResult lookup = lookup_session(chosen.data_dirs, {chosen.uid, chosen.session, chosen.host});
+    if (!lookup.found) {
+      std::fprintf(stderr, "sim_replay: %s\n", lookup.error.c_str());
+      return kExitRefused;
+    }
+    chosen.session_dir = lookup.found->dir;
+    std::fprintf(stderr, "sim_replay: session %s (host %s)\n", chosen.session_dir.c_str(), lookup.found->host.c_str());
+  }
+
   const auto start = std::chrono::steady_clock::now();
   ProgressLine line(0.0, ::isatty(STDERR_FILENO) == 1);
   bool line_started = false;
   ProgressFn progress;
-  if (!options->quiet) {
+  if (!chosen.quiet) {
     progress = [&](double done_s, double total_s) {
       if (!line_started) line = ProgressLine(total_s, ::isatty(STDERR_FILENO) == 1);
       line_started = true;
@@ -38,7 +51,7 @@ int main(int argc, char** argv) {
       std::fputs(line.step(done_s, elapsed).c_str(), stderr);
     };
   }
-  const ReplayResult result = replay_session(*options, progress);
+  const ReplayResult result = replay_session(chosen, progress);
   std::fputs(line.finish().c_str(), stderr);
 
   for (const std::string& warning : result.warnings) std::fprintf(stderr, "sim_replay: warning: %s\n", warning.c_str());

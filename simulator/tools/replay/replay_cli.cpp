@@ -44,6 +44,22 @@ std::optional<ReplayOptions> parse_cli(const std::vector<std::string>& args, Cli
         return std::nullopt;
       }
       view_given = true;
+    } else if (is_option(arg, "--data-dir")) {
+      const auto value = option_value(args, i, "--data-dir", "a folder", error.message);
+      if (!value) return std::nullopt;
+      options.data_dirs.emplace_back(*value);
+    } else if (is_option(arg, "--uid")) {
+      const auto value = option_value(args, i, "--uid", "a participant id", error.message);
+      if (!value) return std::nullopt;
+      options.uid = *value;
+    } else if (is_option(arg, "--session")) {
+      const auto value = option_value(args, i, "--session", "a session folder's name or id", error.message);
+      if (!value) return std::nullopt;
+      options.session = *value;
+    } else if (is_option(arg, "--host")) {
+      const auto value = option_value(args, i, "--host", "a host id", error.message);
+      if (!value) return std::nullopt;
+      options.host = *value;
     } else if (arg == "--check-only") {
       check_only = true;
     } else if (arg == "--force") {
@@ -55,7 +71,22 @@ std::optional<ReplayOptions> parse_cli(const std::vector<std::string>& args, Cli
       return std::nullopt;
     }
   }
-  if (positional.size() != 1 || positional[0].empty()) {
+  // Either the session's folder, or where to look for it and which one.
+  if (!options.data_dirs.empty()) {
+    if (!positional.empty()) {
+      error.message = "give SESSION_DIR or --data-dir with --uid or --session, not both";
+      return std::nullopt;
+    }
+    if (options.uid.has_value() == options.session.has_value()) {
+      error.message = options.uid ? "--uid and --session: give one of them"
+                                  : "--data-dir needs --uid UID or --session ID (which session to replay)";
+      return std::nullopt;
+    }
+  } else if (options.uid || options.session || options.host) {
+    error.message = std::string(options.uid ? "--uid" : options.session ? "--session" : "--host") +
+                    " picks a session under --data-dir folders: give --data-dir DIR (or the SESSION_DIR alone)";
+    return std::nullopt;
+  } else if (positional.size() != 1 || positional[0].empty()) {
     error.message = positional.empty() ? "SESSION_DIR is missing" : "expected one SESSION_DIR";
     return std::nullopt;
   }
@@ -67,13 +98,14 @@ std::optional<ReplayOptions> parse_cli(const std::vector<std::string>& args, Cli
     error.message = "--view chooses the video's camera: it needs --video FILE";
     return std::nullopt;
   }
-  options.session_dir = positional[0];
+  if (options.data_dirs.empty()) options.session_dir = positional[0];
   return options;
 }
 
 std::string usage_text() {
   return "Usage: sim_replay SESSION_DIR [--video FILE] [--view participant|top] [--check-only]\n"
          "                  [--out-dir DIR] [--force] [--quiet]\n"
+         "       sim_replay --data-dir DIR [--data-dir DIR...] (--uid UID | --session ID) [--host HOST] [options]\n"
          "\n"
          "Re-runs a recorded session (a folder with session.json, trajectories.csv and events.jsonl, as\n"
          "sim_rfb --data-dir writes it) from its scenario, seed and recorded inputs, and checks that every\n"
@@ -82,6 +114,12 @@ std::string usage_text() {
          "and frame rate.\n"
          "\n"
          "Options:\n"
+         "  --data-dir DIR     look for the session under DIR (repeat it for several hosts' data folders or the\n"
+         "                     shared store <store>/<host_id>/<folder>/) instead of giving its SESSION_DIR\n"
+         "  --uid UID          the session of participant UID (session.json's uid)\n"
+         "  --session ID       the session folder named ID (3-p003), or the manager's session id (3)\n"
+         "  --host HOST        only sessions of HOST (manager.json's host, else the store folder's name); use it\n"
+         "                     when UID or ID matches sessions of several hosts (listed in the error)\n"
          "  --video FILE       write the video to FILE (MP4, H.264, yuv420p; replaced if it exists)\n"
          "  --view VIEW        participant (default: the participant's camera and HUD) or top (the whole map\n"
          "                     from above, with the HUD)\n"

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // sim_replay's command line: `sim_replay SESSION_DIR [--video FILE] [--view participant|top] [--check-only]
-// [--out-dir DIR] [--force]`, `--help`. Pure: parsing only.
+// [--out-dir DIR] [--force]`, or the session found by uid or id across hosts' data folders with
+// `--data-dir DIR... --uid UID|--session ID [--host HOST]` in place of SESSION_DIR; `--help`. Pure: parsing only.
 #pragma once
 
 #include <filesystem>
@@ -20,6 +21,12 @@ enum class View {
 struct ReplayOptions {
   bool help = false;                          ///< --help / -h: print usage_text() and exit 0
   std::filesystem::path session_dir;          ///< SESSION_DIR: a folder with session.json (docs/data.md)
+  /// --data-dir DIR (repeated): hosts' data folders or the shared store to find the session in (by --uid or
+  /// --session) instead of SESSION_DIR; session_dir is then set by the caller (lookup_session).
+  std::vector<std::filesystem::path> data_dirs;
+  std::optional<std::string> uid;      ///< --uid: the session of this participant (session.json's uid)
+  std::optional<std::string> session;  ///< --session: a folder name ("3-p003") or the manager's session id ("3")
+  std::optional<std::string> host;     ///< --host: only sessions of this host
   std::optional<std::filesystem::path> video; ///< --video FILE: write an H.264 MP4; none = check only
   View view = View::Participant;              ///< --view
   std::optional<std::filesystem::path> out_dir;  ///< --out-dir: keep the replay's own session data here

@@ -20,14 +20,16 @@ namespace {
 int run(const rfbsim::report::CliOptions& options) {
   using namespace rfbsim::report;
   std::error_code ec;
-  if (!std::filesystem::is_directory(options.data_dir, ec)) {
-    std::fprintf(stderr, "sim_report: %s: no such folder\n", options.data_dir.c_str());
-    return 2;
+  for (const std::filesystem::path& dir : options.data_dirs) {
+    if (!std::filesystem::is_directory(dir, ec)) {
+      std::fprintf(stderr, "sim_report: %s: no such folder\n", dir.c_str());
+      return 2;
+    }
   }
 
   const auto start = std::chrono::steady_clock::now();
   std::optional<ProgressBar> bar;
-  const JobResult result = run_report(options.data_dir, options.out_dir, [&](std::size_t done, std::size_t total) {
+  const JobResult result = run_report(options.data_dirs, options.out_dir, [&](std::size_t done, std::size_t total) {
     if (!bar) bar.emplace(total, ::isatty(STDERR_FILENO) == 1);
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fputs(bar->step(done, elapsed).c_str(), stderr);
@@ -38,9 +40,18 @@ int run(const rfbsim::report::CliOptions& options) {
     std::fprintf(stderr, "sim_report: skipped %s: %s\n", s.folder.c_str(), s.reason.c_str());
   }
   for (const std::string& w : result.warnings) std::fprintf(stderr, "sim_report: warning: %s\n", w.c_str());
+  for (const RepeatedFolder& r : result.repeats) {
+    std::fprintf(stderr, "sim_report: note: %s is %s again (%s); counted once\n", r.folder.c_str(), r.same_as.c_str(),
+                 r.why.c_str());
+  }
+  for (const std::string& d : result.duplicate_uids) {
+    std::fprintf(stderr, "sim_report: warning: duplicate uid: %s; flagged duplicate_uid\n", d.c_str());
+  }
   for (const std::string& e : result.write_errors) std::fprintf(stderr, "sim_report: %s\n", e.c_str());
   if (result.sessions_found == 0) {
-    std::fprintf(stderr, "sim_report: no session folders (with a session.json) under %s\n", options.data_dir.c_str());
+    std::string where;
+    for (const std::filesystem::path& dir : options.data_dirs) where += (where.empty() ? "" : ", ") + dir.string();
+    std::fprintf(stderr, "sim_report: no session folders (with a session.json) under %s\n", where.c_str());
   }
   std::fprintf(stderr, "sim_report: %zu sessions reported, %zu skipped\n", result.sessions_reported,
                result.skipped.size());

@@ -113,6 +113,7 @@ ManagerRecord parse_manager_record(const std::string& bytes, const std::filesyst
   if (!known_state(record.state)) fail(file, "key 'state': unknown state '" + record.state + "'");
   record.detail = text(doc, "detail", file, false).value_or("");
   record.data_incomplete = text(doc, "data_incomplete", file, false);
+  record.host = text(doc, "host", file, false);
 
   // When the link was spent, counted from the manager creating the session (both on the manager's clock).
   const long long created = *time(doc, "created_at", file, false);

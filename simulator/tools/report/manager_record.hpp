@@ -26,6 +26,8 @@ struct ManagerRecord {
   /// participant's browser); none while the link is unspent.
   std::optional<double> spent_after;
   std::optional<std::string> data_incomplete;  ///< the reason sim_rfb gave the manager; none when complete
+  /// The host id of the manager that ran the session; none in files from managers that did not record it.
+  std::optional<std::string> host;
 };
 
 /// Every state manager.json may hold, space-separated in the manager's order.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// sim_report's command line: `sim_report DATA_DIR [--out DIR]`, `--help`. Pure: parsing only.
+// sim_report's command line: `sim_report DATA_DIR [DATA_DIR...] [--out DIR]`, `--help`. Pure: parsing only.
 #pragma once
 
 #include <filesystem>
@@ -12,8 +12,9 @@ namespace rfbsim::report {
 /// What the command line asks for.
 struct CliOptions {
   bool help = false;              ///< --help / -h: print usage_text() and exit 0
-  std::filesystem::path data_dir; ///< DATA_DIR
-  std::filesystem::path out_dir;  ///< --out, else DATA_DIR/report
+  /// DATA_DIR...: hosts' data folders, the shared store or a merged copy, at least one, in the order given.
+  std::vector<std::filesystem::path> data_dirs;
+  std::filesystem::path out_dir;  ///< --out, else the first DATA_DIR's report/
 };
 
 /// A command line that cannot be run (exit 2); the message says what is wrong.

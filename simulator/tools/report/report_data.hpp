@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "duplicate_uids.hpp"
 #include "group_summary.hpp"
 #include "participation.hpp"
 #include "session_metrics.hpp"
@@ -17,6 +18,13 @@ struct SkippedSession {
   std::string reason;  ///< the reader's message (names the file and line) or another failure
 };
 
+/// A session folder found again under the data folders (another copy of a reported one), counted once.
+struct RepeatedFolder {
+  std::string folder;   ///< the copy left out, as found
+  std::string same_as;  ///< the folder reported in its place (SessionMetrics::folder)
+  std::string why;      ///< how the two were recognised as one session (tools::RepeatedSession::why)
+};
+
 /// A session's trajectory plot for report.html.
 struct SessionPlot {
   std::string svg;      ///< inline SVG (trajectory_svg)
@@ -25,12 +33,14 @@ struct SessionPlot {
 
 /// The report's content.
 struct ReportData {
-  std::string data_dir;                 ///< as given on the command line
+  std::vector<std::string> data_dirs;   ///< as given on the command line, in order
   std::vector<SessionMetrics> sessions; ///< in folder order
   std::vector<GroupSummary> groups;     ///< summarize(sessions)
   std::vector<Exclusion> exclusions;    ///< exclusions(sessions): left out of groups, with why
   std::vector<SkippedSession> skipped;
   std::vector<std::string> warnings;    ///< reported all the same, e.g. a broken manager.json (names the file)
+  std::vector<DuplicateUid> duplicates;  ///< uids with sessions on more than one host (flag_duplicate_uids)
+  std::vector<RepeatedFolder> repeats;   ///< folders found twice, reported once
   std::vector<SessionPlot> plots;            ///< parallel to sessions; may be empty (no plots)
   std::vector<std::string> map_definitions;  ///< MapDrawing::definition of every map the plots use
 };

@@ -136,6 +136,31 @@ void plots(std::string& out, const ReportData& data) {
   }
 }
 
+// Uids on two hosts (said whenever the report spans hosts, "none" included) and folders found twice.
+void hosts(std::string& out, const ReportData& data) {
+  if (!data.duplicates.empty() || host_count(data.sessions) > 1) {
+    out += "<h2>Duplicate participants</h2>\n";
+    if (data.duplicates.empty()) {
+      out += "<p>No uid has sessions on more than one host (" + std::to_string(host_count(data.sessions)) + " hosts).</p>\n";
+    } else {
+      out += "<p>" + html_escape(kDuplicatesNote) + "</p>\n";
+      std::vector<Row> rows;
+      for (const DuplicateUid& d : data.duplicates) {
+        rows.push_back({html_escape(d.uid), html_escape(joined(d.hosts)), html_escape(joined(d.folders))});
+      }
+      table(out, {"uid", "hosts", "sessions"}, rows);
+    }
+  }
+  if (!data.repeats.empty()) {
+    out += "<h2>Sessions found twice</h2>\n<p>Each was reported once, from the first folder found.</p>\n";
+    std::vector<Row> rows;
+    for (const RepeatedFolder& r : data.repeats) {
+      rows.push_back({html_escape(r.folder), html_escape(r.same_as), html_escape(r.why)});
+    }
+    table(out, {"left out", "reported", "why the same"}, rows);
+  }
+}
+
 // The sessions left out of the statistics (counted per reason), the skipped ones and the warnings.
 void left_out(std::string& out, const ReportData& data) {
   if (!data.exclusions.empty()) {
@@ -170,7 +195,10 @@ std::string html_report(const ReportData& data) {
     for (const std::string& d : data.map_definitions) out += d;
     out += "</defs></svg>\n";
   }
-  out += "<h1>rfbsim session report</h1>\n<p>Data folder: " + html_escape(data.data_dir) + "<br>" +
+  std::string folders;
+  for (const std::string& d : data.data_dirs) folders += (folders.empty() ? "" : ", ") + html_escape(d);
+  out += std::string("<h1>rfbsim session report</h1>\n<p>") +
+         (data.data_dirs.size() == 1 ? "Data folder: " : "Data folders: ") + folders + "<br>" +
          std::to_string(data.sessions.size()) + " sessions reported (" + std::to_string(data.groups.front().sessions) +
          " in the statistics, " + std::to_string(data.groups.front().excluded) +
          " without a participant left out), " + std::to_string(data.skipped.size()) +
@@ -178,6 +206,7 @@ std::string html_report(const ReportData& data) {
   overview(out, data);
   histograms(out, data);
   session_table(out, data);
+  hosts(out, data);
   left_out(out, data);
   plots(out, data);
   out += "</body></html>\n";

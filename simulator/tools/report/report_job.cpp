@@ -7,14 +7,16 @@
 #include <map>
 #include <optional>
 
-#include "record/digest.hpp"
+#include "duplicate_uids.hpp"
 #include "manager_record.hpp"
+#include "record/digest.hpp"
 #include "participation.hpp"
 #include "record/session_log.hpp"
 #include "report_csv.hpp"
 #include "report_html.hpp"
 #include "report_markdown.hpp"
 #include "scenario/scenario.hpp"
+#include "session_catalog.hpp"
 #include "session_samples.hpp"
 #include "trajectory_plot.hpp"
 
@@ -73,9 +75,11 @@ std::string caption(const sim::SessionLog& log, const SampledSession& samples, c
   return out;
 }
 
-std::string folder_name(const std::filesystem::path& dir, const std::filesystem::path& data_dir) {
-  const std::filesystem::path relative = dir.lexically_relative(data_dir);
-  return relative.empty() ? dir.string() : relative.string();
+// A session's folder as the report names it: relative to the data folder when there is one (as before
+// several were taken), else as found, which tells the data folders apart.
+std::string folder_name(const tools::FoundSession& found, std::size_t data_dirs) {
+  if (data_dirs > 1) return found.dir.string();
+  return found.relative.string();
 }
 
 // manager.json into `metrics`, when the folder has one. A broken one, or one of another participant (a folder
@@ -127,22 +131,29 @@ int JobResult::exit_status() const {
 
 JobResult run_report(const std::filesystem::path& data_dir, const std::filesystem::path& out_dir,
                      const ProgressFn& progress) {
+  return run_report(std::vector<std::filesystem::path>{data_dir}, out_dir, progress);
+}
+
+JobResult run_report(const std::vector<std::filesystem::path>& data_dirs, const std::filesystem::path& out_dir,
+                     const ProgressFn& progress) {
   JobResult result;
   ReportData data;
-  data.data_dir = data_dir.string();
+  for (const std::filesystem::path& dir : data_dirs) data.data_dirs.push_back(dir.string());
   MapCache maps;
 
   // Each session on its own: whatever goes wrong with one is its reason for being skipped.
-  const std::vector<std::filesystem::path> dirs = sim::find_session_dirs(data_dir);
-  result.sessions_found = dirs.size();
-  for (std::size_t i = 0; i < dirs.size(); ++i) {
-    const std::string folder = folder_name(dirs[i], data_dir);
+  const tools::SessionCatalog catalog = tools::catalog_sessions(data_dirs);
+  const std::vector<tools::FoundSession>& found = catalog.sessions;
+  result.sessions_found = found.size();
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    const std::string folder = folder_name(found[i], data_dirs.size());
     try {
-      const sim::SessionLog log = sim::read_session(dirs[i]);
+      const sim::SessionLog log = sim::read_session(found[i].dir);
       const SampledSession samples = assemble_samples(log);
       SessionMetrics metrics = session_metrics(log, samples);
       metrics.folder = folder;
-      add_record(dirs[i], log, metrics, data.warnings);
+      metrics.host = found[i].host;
+      add_record(found[i].dir, log, metrics, data.warnings);
       const LoadedMap& map = maps.get(log.meta.scenario_file);
       SessionPlot plot{trajectory_svg(samples, map.drawing ? &*map.drawing : nullptr), caption(log, samples, map)};
       data.sessions.push_back(std::move(metrics));
@@ -152,8 +163,16 @@ JobResult run_report(const std::filesystem::path& data_dir, const std::filesyste
     } catch (const std::exception& e) {
       data.skipped.push_back({folder, std::string("cannot be reported: ") + e.what()});
     }
-    if (progress) progress(i + 1, dirs.size());
+    if (progress) progress(i + 1, found.size());
   }
+  // Copies of a reported session (a host's folder and the store's both given) count once; a uid on two
+  // hosts is flagged, not dropped: the analysis decides.
+  for (const tools::RepeatedSession& r : catalog.repeats) {
+    data.repeats.push_back({r.dir.string(), folder_name(found[r.kept], data_dirs.size()), r.why});
+  }
+  data.duplicates = flag_duplicate_uids(data.sessions);
+  for (const DuplicateUid& d : data.duplicates) result.duplicate_uids.push_back(duplicate_uid_line(d, data.sessions));
+  result.repeats = data.repeats;
   result.sessions_reported = data.sessions.size();
   result.skipped = data.skipped;
   result.warnings = data.warnings;

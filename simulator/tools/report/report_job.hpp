@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The report job: every session folder under a data folder read, measured and plotted, and the four
-// report files written. A session that cannot be read is skipped with its reason; it never stops the rest.
+// The report job: every session folder under one or more data folders read, measured and plotted, and the
+// four report files written. A session that cannot be read is skipped with its reason; it never stops the rest.
 // sim_manager's manager.json, where a folder has one, adds how the session ended and whether anyone saw it.
 #pragma once
 
@@ -23,6 +23,8 @@ struct JobResult {
   std::vector<std::string> warnings;    ///< ReportData::warnings; they do not change the exit status
   std::vector<std::string> write_errors;  ///< output files that could not be written, with why
   std::vector<std::filesystem::path> written;  ///< output files written
+  std::vector<std::string> duplicate_uids;  ///< duplicate_uid_line() of each uid seen on two hosts; exit status unchanged
+  std::vector<RepeatedFolder> repeats;      ///< session folders found twice and reported once
 
   /// sim_report's exit status: 0 when every session was reported (at least one), else 1.
   [[nodiscard]] int exit_status() const;
@@ -31,8 +33,14 @@ struct JobResult {
 /// Called after each session with how many are done of how many.
 using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
 
-/// Reads every session under `data_dir` (find_session_dirs) and writes sessions.csv, summary.csv,
-/// report.md and report.html into `out_dir`, creating it. `progress` may be empty.
+/// Reads every session under `data_dirs` (tools::catalog_sessions: several hosts' data folders or the shared
+/// store; a session found twice is reported once; each session's host recorded) and writes sessions.csv,
+/// summary.csv, report.md and report.html into `out_dir`, creating it. A uid with sessions on two hosts is
+/// flagged in them. `progress` may be empty.
+JobResult run_report(const std::vector<std::filesystem::path>& data_dirs, const std::filesystem::path& out_dir,
+                     const ProgressFn& progress = {});
+
+/// run_report over one data folder.
 JobResult run_report(const std::filesystem::path& data_dir, const std::filesystem::path& out_dir,
                      const ProgressFn& progress = {});
 

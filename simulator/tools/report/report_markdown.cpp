@@ -35,11 +35,20 @@ std::string optional_cell(const std::optional<double>& v) { return v ? format_fi
 
 std::string with_unit(const Column& c) { return c.unit.empty() ? c.name : c.name + " (" + c.unit + ")"; }
 
+// Strings from the data, each escaped, joined with ", " (an escaped comma would read "\,").
+std::string escaped_list(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& item : items) out += (out.empty() ? "" : ", ") + markdown_escape(item);
+  return out;
+}
+
 }  // namespace
 
 std::string markdown_report(const ReportData& data) {
   std::string out = "# rfbsim session report\n\n";
-  out += "Data folder: " + markdown_escape(data.data_dir) + "  \n";
+  std::string folders;
+  for (const std::string& d : data.data_dirs) folders += (folders.empty() ? "" : ", ") + markdown_escape(d);
+  out += (data.data_dirs.size() == 1 ? "Data folder: " : "Data folders: ") + folders + "  \n";
   out += std::to_string(data.sessions.size()) + " sessions reported (" + std::to_string(data.groups.front().sessions) +
          " in the statistics, " + std::to_string(data.groups.front().excluded) + " without a participant left out), " +
          std::to_string(data.skipped.size()) + " skipped. Definitions of every measure: docs/report.md.\n\n";
@@ -93,6 +102,30 @@ std::string markdown_report(const ReportData& data) {
   }
   table(out, header, rows);
   out += "Every column, unrounded: sessions.csv.\n\n";
+
+  // A uid on two hosts: said whenever the report spans hosts, so that "none" is a finding too.
+  if (!data.duplicates.empty() || host_count(data.sessions) > 1) {
+    out += "## Duplicate participants\n\n";
+    if (data.duplicates.empty()) {
+      out += "No uid has sessions on more than one host (" + std::to_string(host_count(data.sessions)) + " hosts).\n\n";
+    } else {
+      out += markdown_escape(kDuplicatesNote) + "\n\n";
+      rows.clear();
+      for (const DuplicateUid& d : data.duplicates) {
+        rows.push_back({markdown_escape(d.uid), escaped_list(d.hosts), escaped_list(d.folders)});
+      }
+      table(out, {"uid", "hosts", "sessions"}, rows);
+    }
+  }
+
+  if (!data.repeats.empty()) {
+    out += "## Sessions found twice\n\nEach was reported once, from the first folder found.\n\n";
+    rows.clear();
+    for (const RepeatedFolder& r : data.repeats) {
+      rows.push_back({markdown_escape(r.folder), markdown_escape(r.same_as), markdown_escape(r.why)});
+    }
+    table(out, {"left out", "reported", "why the same"}, rows);
+  }
 
   if (!data.exclusions.empty()) {
     out += "## Left out of the statistics\n\n";

@@ -26,6 +26,10 @@ constexpr double kNeverMovedPath = 0.1;  // m
 struct SessionMetrics {
   // Who and what.
   std::string folder;  ///< the session folder relative to the data folder (set by the caller)
+  /// The host that ran it: manager.json's `host`, else the one its folder's place names (set by the caller;
+  /// tools::host_from_layout).
+  std::string host;
+  bool duplicate_uid = false;  ///< its uid has sessions on more than one host (flag_duplicate_uids)
   std::string uid, scenario, scenario_file, seed;
   std::string outcome;     ///< completed, timeout or "" (none)
   std::string end_reason;  ///< completed, timeout, signal, error or "" (did not end cleanly)
