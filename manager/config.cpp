@@ -5,14 +5,19 @@
 #include <arpa/inet.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <functional>
 #include <map>
+#include <optional>
 
 #include "client_address.hpp"
+#include "copy_command.hpp"
 #include "launch_plan.hpp"
+#include "routes.hpp"
 #include "start_request.hpp"
+#include "uid_registry.hpp"
 
 namespace rfbsim::manager {
 
@@ -115,6 +120,25 @@ bool is_origin(const std::string& origin) {
   return true;
 }
 
+// "ID=ADDRESS:PORT", one entry of cluster_peers.
+std::optional<ClusterPeer> parse_cluster_peer(const std::string& entry) {
+  const std::size_t eq = entry.find('=');
+  const std::size_t colon = entry.rfind(':');
+  if (eq == std::string::npos || colon == std::string::npos || colon < eq) return std::nullopt;
+  ClusterPeer peer;
+  peer.id = entry.substr(0, eq);
+  peer.address = entry.substr(eq + 1, colon - eq - 1);
+  if (!is_host_id(peer.id) || !parse_integer(entry.substr(colon + 1), 1, 65535, peer.port)) return std::nullopt;
+  // A host name or a numeric IPv4 address: letters, digits, dots and dashes.
+  if (peer.address.empty() || peer.address.size() > 253) return std::nullopt;
+  for (const char ch : peer.address) {
+    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '.' ||
+                    ch == '-';
+    if (!ok) return std::nullopt;
+  }
+  return peer;
+}
+
 const std::map<std::string, Setting>& settings() {
   static const std::map<std::string, Setting> table = {
       {"listen_address", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
@@ -196,6 +220,18 @@ const std::map<std::string, Setting>& settings() {
          c.public_url = v.front();
          return "";
        }}},
+      {"path_prefix", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (!is_path_prefix(v.front())) return "expected / and 1-32 of a-z, 0-9 and - (e.g. /h2)";
+         c.path_prefix = v.front();
+         return "";
+       }}},
+      {"agent_port", {false, integer(&ManagerConfig::agent_port, 0, 65535)}},
+      {"agent_bind", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         in_addr address{};
+         if (::inet_pton(AF_INET, v.front().c_str(), &address) != 1) return "expected a numeric IPv4 address";
+         c.agent_bind = v.front();
+         return "";
+       }}},
       {"limit_address_space_mb", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          if (!parse_integer<std::uint64_t>(v.front(), 0, 1ULL << 30, c.limits.address_space_mb)) {
            return "expected MiB, 0 = no limit";
@@ -245,6 +281,34 @@ const std::map<std::string, Setting>& settings() {
          }
          return "";
        }}},
+      {"cluster_peers", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         std::vector<ClusterPeer> peers;
+         for (const std::string& entry : v) {
+           const auto peer = parse_cluster_peer(entry);
+           if (!peer) return "'" + entry + "' is not ID=ADDRESS:PORT (ID: 1-32 of a-z 0-9 -, PORT: 1..65535)";
+           for (const ClusterPeer& other : peers) {
+             if (other.id == peer->id) return "host id '" + peer->id + "' is listed twice";
+           }
+           peers.push_back(*peer);
+         }
+         c.cluster_peers = std::move(peers);
+         return "";
+       }}},
+      {"cluster_secret_file", {false, text(&ManagerConfig::cluster_secret_file)}},
+      {"registry_port", {false, integer(&ManagerConfig::registry_port, 1, 65535)}},
+      {"registry_bind", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         in_addr address{};
+         if (::inet_pton(AF_INET, v.front().c_str(), &address) != 1) return "expected a numeric IPv4 address";
+         c.registry_bind = v.front();
+         return "";
+       }}},
+      {"after_session_command", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (std::string problem = copy_command_problem(v); !problem.empty()) return problem;
+         c.after_session_command = v;
+         return "";
+       }}},
+      {"after_session_retries", {false, integer(&ManagerConfig::after_session_retries, 0, 100)}},
+      {"after_session_timeout_s", {false, seconds(&ManagerConfig::after_session_timeout, 1)}},
       {"limit_cpu_slack_s", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          long long value = 0;
          if (!parse_integer(v.front(), 0LL, 86400LL, value)) return "expected whole seconds 0..86400";
@@ -287,7 +351,7 @@ std::string manager_usage() {
          "                   [--max-duration-s S] [--idle-timeout-s S]\n"
          "                   [--data-dir DIR] [--scenarios A,B] [--frame-origins O1,O2] [--admin-token T]\n"
          "                   [--link-secret S] [--allow-repeat true|false] [--host-id ID] [--web-root DIR]\n"
-         "                   [--public-url ORIGIN]\n"
+         "                   [--public-url ORIGIN] [--path-prefix /ID] [--agent-port N] [--agent-bind ADDR]\n"
          "       sim_manager [--config FILE] --sign 'uid=...&scenario=...'\n"
          "Every flag is also a key of the YAML config file (--max-sessions N is max_sessions: N).\n"
          "  --listen-address ADDR   numeric IPv4 address (default 127.0.0.1)\n"
@@ -320,6 +384,11 @@ std::string manager_usage() {
          "  --host-id ID            this host's name in the index (default: the host name)\n"
          "  --web-root DIR          the participant page (default: the built or installed one)\n"
          "  --public-url ORIGIN     this host's public origin; /start redirects there (several hosts)\n"
+         "  --path-prefix /ID       this host's part of a balancer's URL space (e.g. /h2): pages, sockets and the\n"
+         "                          admin API answer under it, /start redirects into it (default: none, or\n"
+         "                          /HOST_ID with cluster peers)\n"
+         "  --agent-port N          HAProxy agent-check port: \"up ready NN%\" or \"drain\" (default 0 = off)\n"
+         "  --agent-bind ADDR       the agent port's numeric IPv4 address (default: the listen address)\n"
          "  --limit-address-space-mb N, --limit-open-files N, --limit-cpu-time-factor F, --limit-cpu-slack-s S\n"
          "                          per-session resource limits (0 = none)\n"
          "  --rate-start-per-minute N, --rate-start-burst N (default 20, 10), --rate-upgrade-per-minute N,\n"
@@ -331,6 +400,14 @@ std::string manager_usage() {
          "  --ws-ping-interval-s S, --ws-pong-timeout-s S   WebSocket keep-alive (default 20, 20; 0 = off)\n"
          "  --trusted-proxies A,B   front ends whose X-Forwarded-For names the participant (addresses or CIDR)\n"
          "  --on-data-incomplete continue|end   when a session's data cannot be written (default continue)\n"
+         "  --after-session-command ARG   one argument of the command that copies each ended session's folder off\n"
+         "                          this host (repeat; no shell; {folder} {folder_name} {uid} {host} {session_id})\n"
+         "  --after-session-retries N (default 5), --after-session-timeout-s S (default 600)   its tries\n"
+         "  --cluster-peers ID=ADDR:PORT,...   every host's uid registry, this one included (several hosts:\n"
+         "                          a uid gets one session in the whole cluster; needs --host-id)\n"
+         "  --cluster-secret-file F the hosts' shared registry secret, 16+ bytes (mode 0600)\n"
+         "  --registry-port N       this host's registry port (default: its cluster-peers entry's)\n"
+         "  --registry-bind ADDR    the registry's numeric IPv4 address (default: listen-address)\n"
          "  --sign QUERY            print QUERY with its link signature (needs a link secret) and exit\n";
 }
 
@@ -405,6 +482,7 @@ ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
     if (!outcome.error.empty()) return outcome;
   }
   bool session_args_from_flags = false;
+  bool copy_command_from_flags = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& flag = args[i];
     if (flag == "--help" || flag == "-h") {
@@ -430,6 +508,14 @@ ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
       if (!session_args_from_flags) outcome.config.session_args.clear();
       session_args_from_flags = true;
       outcome.config.session_args.push_back(value);
+      continue;
+    }
+    if (flag == "--after-session-command") {
+      // Repeated, one argument each (a path or an rclone flag may hold a comma); the flags' list replaces the
+      // file's as a whole, and is checked once it is complete (below).
+      if (!copy_command_from_flags) outcome.config.after_session_command.clear();
+      copy_command_from_flags = true;
+      outcome.config.after_session_command.push_back(value);
       continue;
     }
     const auto setting = settings().find(flag_to_key(flag));
@@ -459,9 +545,39 @@ ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
       return outcome;
     }
   }
+  // In a cluster each host owns "/<host_id>" of the balancer's URL space unless told otherwise (the balancer
+  // routes /<id>/... to host <id>, and a registry answer sends a participant to /<id>/start).
+  ManagerConfig& config = outcome.config;
+  if (config.path_prefix.empty() && !config.cluster_peers.empty() && is_path_prefix("/" + config.host_id)) {
+    config.path_prefix = "/" + config.host_id;
+  }
   if (outcome.error.empty()) outcome.error = validate_config(outcome.config);
   return outcome;
 }
+
+namespace {
+
+// The uid registry's settings fit together: a secret, this host among the peers, its port the peers know.
+std::string cluster_problem(const ManagerConfig& config) {
+  if (config.cluster_peers.empty()) {
+    if (!config.cluster_secret_file.empty() || config.registry_port != 0 || !config.registry_bind.empty()) {
+      return "cluster_secret_file, registry_port and registry_bind need cluster_peers";
+    }
+    return "";
+  }
+  if (config.cluster_secret_file.empty()) return "cluster_peers needs cluster_secret_file (the hosts' shared secret)";
+  if (config.host_id.empty()) return "cluster_peers needs host_id (this host's id among the peers)";
+  const auto self = std::find_if(config.cluster_peers.begin(), config.cluster_peers.end(),
+                                 [&](const ClusterPeer& peer) { return peer.id == config.host_id; });
+  if (self == config.cluster_peers.end()) return "host_id '" + config.host_id + "' is not one of cluster_peers";
+  if (config.registry_port != 0 && config.registry_port != self->port) {
+    return "registry_port " + std::to_string(config.registry_port) + " differs from this host's cluster_peers entry (" +
+           std::to_string(self->port) + ")";
+  }
+  return "";
+}
+
+}  // namespace
 
 std::string validate_config(const ManagerConfig& config) {
   if (config.tls_certificate.empty() != config.tls_private_key.empty()) {
@@ -475,10 +591,12 @@ std::string validate_config(const ManagerConfig& config) {
   if (config.require_link_expiry && config.link_secret.empty()) {
     return "require_link_expiry needs link_secret: an unsigned exp could simply be edited";
   }
+  if (std::string problem = cluster_problem(config); !problem.empty()) return problem;
   // The manager's own flags (where the session listens, its data folder...) are not the config's to change.
   if (std::string problem = session_args_problem(config.session_args, config.session_kind); !problem.empty()) {
     return problem;
   }
+  if (std::string problem = copy_command_problem(config.after_session_command); !problem.empty()) return problem;
   return "";
 }
 

@@ -58,6 +58,14 @@ enum class DataFailurePolicy {
   kEnd,       ///< the session ends (the page says so and offers the way back to the survey)
 };
 
+/// One host of a cluster as cluster_peers names it ("ID=ADDRESS:PORT"): its host id and its uid registry's
+/// address and port.
+struct ClusterPeer {
+  std::string id;       ///< the host's host_id: 1..32 of [a-z0-9-]
+  std::string address;  ///< a numeric IPv4 address or a host name
+  int port = 0;         ///< its registry port, 1..65535
+};
+
 /// Everything sim_manager can be configured with; start from the defaults.
 struct ManagerConfig {
   std::string listen_address = "127.0.0.1";  ///< numeric IPv4 address; loopback unless told otherwise
@@ -98,14 +106,33 @@ struct ManagerConfig {
   /// This host's own public origin (e.g. https://h2.study.example.org); when set, /start redirects there,
   /// so that a load balancer can hand new links to any host and the session stays with its host.
   std::string public_url;
+  /// This manager's part of a balancer's URL space, "/" and 1-32 of [a-z0-9-] (e.g. "/h2"; "" = none): its
+  /// pages, status, sockets and admin API answer under it as well as without it, and /start redirects into it.
+  /// With cluster_peers and no path_prefix it is "/" + host_id.
+  std::string path_prefix;
+  /// HAProxy's agent-check port (0 = off): each connection reads "up ready NN%" or "drain" (agent_check.hpp).
+  int agent_port = 0;
+  std::string agent_bind;  ///< the agent port's numeric IPv4 address; empty = listen_address
   ProcessLimits limits;
   AbuseLimits abuse;
   /// Front ends (nginx, HAProxy) whose X-Forwarded-For names the participant: addresses or CIDR ranges.
   std::vector<std::string> trusted_proxies;
   DataFailurePolicy on_data_incomplete = DataFailurePolicy::kContinue;
+  /// Run once a session's folder is final (its process gone, manager.json written) to copy it off this host: an
+  /// argument list, never a shell, with {folder} {folder_name} {uid} {host} {session_id} replaced (copy_command.hpp);
+  /// empty = no copy. E.g. [rsync, -a, "{folder}/", "store:/study/{host}/{folder_name}/"].
+  std::vector<std::string> after_session_command;
+  int after_session_retries = 5;  ///< tries after a failed first one (backoff 5 s, doubling up to 5 min)
+  std::chrono::seconds after_session_timeout{600};  ///< one try's limit; then SIGTERM, SIGKILL after stop_grace
   /// What the offered scenarios' files say (load_scenario_facts, at start-up; kSimRfb only): spawn names for
   /// /start's checks and task limits for max_duration. Not a setting; empty = nothing known.
   std::vector<ScenarioFacts> scenario_facts;
+  /// Every host of the cluster, this one included (empty: a single host). With peers, a uid's home is
+  /// decided by the uid registry before a session starts (docs/architecture.md, "uid registry").
+  std::vector<ClusterPeer> cluster_peers;
+  std::string cluster_secret_file;  ///< the hosts' shared registry secret (>= 16 bytes); needed with peers
+  int registry_port = 0;            ///< this host's registry port; 0 = its own cluster_peers entry's
+  std::string registry_bind;        ///< the registry's numeric IPv4 address; empty = listen_address
 };
 
 /// The outcome of reading settings: a config, or a message naming the file, line or flag at fault.

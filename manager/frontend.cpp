@@ -19,6 +19,7 @@
 #include "public_intake.hpp"
 #include "query.hpp"
 #include "rate_limiter.hpp"
+#include "registry_client.hpp"
 #include "relay.hpp"
 #include "routes.hpp"
 #include "session_views.hpp"
@@ -38,6 +39,10 @@ using CloseCode = websocketpp::close::status::value;
 constexpr std::size_t kMaxTarget = 4096;
 // How long the busy page waits before it tries the link again.
 constexpr int kBusyRetrySeconds = 10;
+// How long the "try again in a moment" page waits when too few hosts answered to decide a uid's home.
+constexpr int kUndecidedRetrySeconds = 5;
+// How long the "previous session is closing" page waits: an ending session is gone within the stop grace.
+constexpr int kPreviousEndingRetrySeconds = 3;
 // How many ended sessions the admin API lists besides the live ones.
 constexpr int kAdminRecentSessions = 200;
 // After a session's socket closes, how long to wait for the process's exit to say why, before telling the
@@ -84,13 +89,14 @@ class FrontendImpl final : public Frontend, public SessionListener {
   using RelayT = Relay<Server>;
 
   FrontendImpl(asio::io_context& io, const ManagerConfig& config, Supervisor& supervisor, Metrics& metrics,
-               std::string web_root, bool tls)
+               std::string web_root, bool tls, RegistryClient* registry)
       : io_(io),
         config_(config),
         supervisor_(supervisor),
         metrics_(metrics),
         web_root_(std::move(web_root)),
         tls_(tls),
+        registry_(registry),
         start_limiter_({static_cast<double>(config.abuse.start_per_minute), static_cast<double>(config.abuse.start_burst)}),
         upgrade_limiter_(
             {static_cast<double>(config.abuse.upgrade_per_minute), static_cast<double>(config.abuse.upgrade_burst)}),
@@ -261,7 +267,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
       refuse(con, 414, Rejection::kBadRequest, "Link too long", "The address is too long to be a study link.");
       return;
     }
-    const Route route = route_request(con->get_request().get_method(), target);
+    const Route route = route_request(con->get_request().get_method(), target, config_.path_prefix);
     switch (route.kind) {
       case RouteKind::kHome: respond_page(con, 200, home_page()); return;
       case RouteKind::kStart:
@@ -291,10 +297,16 @@ class FrontendImpl final : public Frontend, public SessionListener {
           refuse(con, 400, Rejection::kBadRequest, "WebSocket only", "This address takes WebSocket connections only.");
         }
         return;
-      case RouteKind::kHealth:
-        respond_json(con, 200, "{\"status\":\"ok\",\"live_sessions\":" + std::to_string(supervisor_.table().size()) +
-                                   ",\"capacity\":" + std::to_string(config_.max_sessions) + "}");
+      case RouteKind::kHealth: {
+        // A balancer's health check takes a draining or stopping host out of its pool for new participants;
+        // the host's own backend (no health check on it) still reaches its live sessions.
+        const bool draining = supervisor_.draining() || supervisor_.shutting_down();
+        respond_json(con, draining ? 503 : 200,
+                     std::string("{\"status\":\"") + (draining ? "draining" : "ok") + "\",\"live_sessions\":" +
+                         std::to_string(supervisor_.table().size()) + ",\"capacity\":" +
+                         std::to_string(config_.max_sessions) + "}");
         return;
+      }
       case RouteKind::kMetrics:
         metrics_.set_connections(intake_.open_total(), intake_.addresses());
         respond(con, 200,
@@ -304,6 +316,14 @@ class FrontendImpl final : public Frontend, public SessionListener {
       case RouteKind::kAdminPage: handle_admin_page(con, route); return;
       case RouteKind::kApiSessions: handle_api_sessions(con); return;
       case RouteKind::kApiEndSession: handle_api_end(con, route); return;
+      case RouteKind::kApiDrain: handle_api_drain(con, true); return;
+      case RouteKind::kApiUndrain: handle_api_drain(con, false); return;
+      case RouteKind::kApiHost:
+        if (admin_allowed(con)) respond_json(con, 200, host_json());
+        return;
+      case RouteKind::kApiCluster:
+        if (admin_allowed(con)) respond_json(con, 200, cluster_json());
+        return;
       case RouteKind::kBadMethod:
         metrics_.count_rejection(Rejection::kBadRequest);
         respond_page(con, 405, error_page(405, "Method not allowed", "This address does not take that method."),
@@ -355,13 +375,58 @@ class FrontendImpl final : public Frontend, public SessionListener {
              "The study link is no longer valid. Please go back to the survey or contact the researcher.");
       return;
     }
+    // Several hosts: a uid this host has no session of starts only where the uid registry decides its home.
+    if (registry_ != nullptr && needs_claim(parsed.request->uid)) {
+      con->defer_http_response();
+      registry_->claim(parsed.request->uid, [this, con, request = *parsed.request, address,
+                                             query = route.query](const std::optional<std::string>& home) {
+        if (home && *home == config_.host_id) {
+          start_session(con, request, address, true);
+          return;
+        }
+        if (home) {
+          // The balancer routes /<host>/ to that host, which serves the uid from now on.
+          const std::string location = "/" + *home + "/start?" + query;
+          respond_page(con, 303, "<!DOCTYPE html><title>Moved</title><a href=\"" + html_escape(location) +
+                                     "\">Continue</a>\n",
+                       {{"Location", location}});
+        } else {
+          // Too few hosts answered: nothing was decided, so the retry (here or elsewhere) is safe.
+          metrics_.count_rejection(Rejection::kBusy);
+          respond_page(con, 503, retry_later_page(kUndecidedRetrySeconds),
+                       {{"Retry-After", std::to_string(kUndecidedRetrySeconds)}});
+        }
+        websocketpp::lib::error_code ec;
+        con->send_http_response(ec);  // a browser that left meanwhile costs nothing
+      });
+      return;
+    }
+    start_session(con, *parsed.request, address, false);
+  }
+
+  // Whether /start of `uid` must ask the uid registry first: this host has no session of it, and could
+  // start one. A full or draining host claims nothing (its busy page sends the participant elsewhere, and
+  // nothing was recorded); an index that cannot be read is left to the supervisor, which says so.
+  bool needs_claim(const std::string& uid) {
+    try {
+      if (supervisor_.has_session_for_uid(uid)) return false;
+    } catch (const std::exception&) {
+      return false;
+    }
+    return !supervisor_.table().full() && !supervisor_.draining() && !supervisor_.shutting_down();
+  }
+
+  // Admits `request` on this host; `deferred`: the response was deferred already (after a claim round).
+  void start_session(const ConnectionPtr& con, const StartRequest& request, const std::string& address,
+                     bool deferred) {
     // A new session's answer waits for its index row, which is written off this thread: defer the response.
     struct Answer {
       bool given = false;
       bool deferred = false;
     };
     const auto answer = std::make_shared<Answer>();  // the reply may come after this function returned
-    supervisor_.start(*parsed.request, address, [this, con, answer](const StartOutcome& outcome) {
+    answer->deferred = deferred;
+    supervisor_.start(request, address, [this, con, answer](const StartOutcome& outcome) {
       answer->given = true;
       answer_start(con, outcome);
       if (answer->deferred) {
@@ -369,7 +434,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
         con->send_http_response(ec);  // a browser that left meanwhile costs nothing
       }
     });
-    if (!answer->given) {
+    if (!answer->given && !answer->deferred) {
       answer->deferred = true;
       con->defer_http_response();
     }
@@ -379,7 +444,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
     switch (outcome.kind) {
       case StartOutcome::Kind::kJoined:
       case StartOutcome::Kind::kStarted: {
-        const std::string location = config_.public_url + "/s/" + outcome.token + "/";
+        // Behind a balancer the session's path carries this host's prefix, which routes it back here.
+        const std::string location = config_.public_url + config_.path_prefix + "/s/" + outcome.token + "/";
         respond_page(con, 302, "<!DOCTYPE html><title>Starting</title><a href=\"" + location + "\">Continue</a>\n",
                      {{"Location", location}});
         return;
@@ -387,6 +453,13 @@ class FrontendImpl final : public Frontend, public SessionListener {
       case StartOutcome::Kind::kBusy:
         metrics_.count_rejection(Rejection::kBusy);
         respond_page(con, 503, busy_page(kBusyRetrySeconds), {{"Retry-After", std::to_string(kBusyRetrySeconds)}});
+        return;
+      case StartOutcome::Kind::kPreviousEnding:
+        // Not the busy page and not a 503: a balancer or a participant must not take this as "try another
+        // host", where a second session of the uid would start. The page reloads itself here.
+        metrics_.count_rejection(Rejection::kBusy);
+        respond_page(con, 409, previous_closing_page(kPreviousEndingRetrySeconds),
+                     {{"Retry-After", std::to_string(kPreviousEndingRetrySeconds)}});
         return;
       case StartOutcome::Kind::kCompleted:
         metrics_.count_rejection(Rejection::kCompleted);
@@ -457,6 +530,13 @@ class FrontendImpl final : public Frontend, public SessionListener {
 
   void handle_admin_page(const ConnectionPtr& con, const Route& route) {
     if (!admin_allowed(con)) return;
+    // The page's addresses are relative to /admin (so that they work under any path prefix): /admin/ would
+    // resolve them one folder too deep, so it is sent to /admin.
+    if (route.file.empty() && split_target(con->get_resource()).first.back() == '/') {
+      respond_page(con, 301, "<!DOCTYPE html><title>Admin</title><a href=\"../admin\">Admin</a>\n",
+                   {{"Location", "../admin"}});
+      return;
+    }
     // Only the admin page's own files: /admin is admin.html, /admin/admin.js its script.
     const std::string file = route.file.empty() ? "admin.html" : route.file;
     if (file != "admin.html" && file != "admin.js") {
@@ -476,7 +556,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
 
   void handle_api_sessions(const ConnectionPtr& con) {
     if (!admin_allowed(con)) return;
-    std::string json = "{\"capacity\":" + std::to_string(config_.max_sessions) + ",\"live\":[";
+    std::string json = "{\"capacity\":" + std::to_string(config_.max_sessions) +
+                       ",\"draining\":" + (supervisor_.draining() ? "true" : "false") + ",\"live\":[";
     bool first = true;
     for (Session* session : supervisor_.table().all()) {
       json += (first ? "" : ",") + session_json(*session, true);
@@ -495,6 +576,54 @@ class FrontendImpl final : public Frontend, public SessionListener {
       return;
     }
     respond_json(con, 200, json + "]}");
+  }
+
+  // POST /api/drain and /api/undrain: the operator takes this host out of the balancer's pool for new uids
+  // (the agent says drain, /healthz 503) while its live sessions go on, or puts it back.
+  void handle_api_drain(const ConnectionPtr& con, bool drain) {
+    if (!admin_allowed(con)) return;
+    if (con->get_request_header("X-Rfbsim-Admin").empty()) {  // as for ending a session: no cross-site posts
+      metrics_.count_rejection(Rejection::kUnauthorized);
+      respond_json(con, 403, "{\"error\":\"send the X-Rfbsim-Admin header\"}");
+      return;
+    }
+    if (supervisor_.draining() != drain) {
+      std::fprintf(stderr, "[manager] %s by the administrator (%zu live session(s))\n",
+                   drain ? "draining: no new participants" : "taking new participants again",
+                   supervisor_.table().size());
+    }
+    supervisor_.set_draining(drain);
+    respond_json(con, 200, host_json());
+  }
+
+  // This host for the admin page and the balancer's operator: its id, drain state and load.
+  std::string host_json() {
+    return "{\"host\":\"" + json_escape(config_.host_id) + "\",\"prefix\":\"" + json_escape(config_.path_prefix) +
+           "\",\"draining\":" + (supervisor_.draining() ? "true" : "false") +
+           ",\"shutting_down\":" + (supervisor_.shutting_down() ? "true" : "false") +
+           ",\"live\":" + std::to_string(supervisor_.table().size()) +
+           ",\"max\":" + std::to_string(config_.max_sessions) + "}";
+  }
+
+  // The cluster's hosts and where each one's pages live on the balancer's origin: the admin page's cluster
+  // view asks each for its sessions there. A single host lists itself.
+  std::string cluster_json() {
+    std::string json = "{\"self\":\"" + json_escape(config_.host_id) + "\",\"prefix\":\"" +
+                       json_escape(config_.path_prefix) + "\",\"hosts\":[";
+    if (config_.cluster_peers.empty()) {
+      json += "{\"id\":\"" + json_escape(config_.host_id) + "\",\"prefix\":\"" + json_escape(config_.path_prefix) +
+              "\"}";
+    }
+    bool first = true;
+    for (const ClusterPeer& peer : config_.cluster_peers) {
+      // The balancer routes /<id>/ to host <id>; this host's own prefix may have been set otherwise.
+      const std::string prefix = peer.id == config_.host_id && !config_.path_prefix.empty() ? config_.path_prefix
+                                                                                            : "/" + peer.id;
+      json += std::string(first ? "" : ",") + "{\"id\":\"" + json_escape(peer.id) + "\",\"prefix\":\"" +
+              json_escape(prefix) + "\"}";
+      first = false;
+    }
+    return json + "]}";
   }
 
   void handle_api_end(const ConnectionPtr& con, const Route& route) {
@@ -532,7 +661,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
     }
     const std::string& target = con->get_resource();
     if (target.size() > kMaxTarget) return reject_websocket(con, 414, Rejection::kBadRequest, "address too long");
-    const Route route = route_request(con->get_request().get_method(), target);
+    const Route route = route_request(con->get_request().get_method(), target, config_.path_prefix);
     if (route.kind != RouteKind::kSessionSocket && route.kind != RouteKind::kWatchSocket) {
       return reject_websocket(con, 404, Rejection::kBadRequest, "no WebSocket at this address");
     }
@@ -668,6 +797,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
   Metrics& metrics_;
   std::string web_root_;
   bool tls_;
+  RegistryClient* registry_;  // null without cluster_peers: a single host decides alone
   Server server_;
   std::map<connection_hdl, std::shared_ptr<RelayT>, std::owner_less<connection_hdl>> relays_;
   // A WebSocket handshake that passed validation and has not opened yet: its session and kind.
@@ -704,16 +834,17 @@ std::shared_ptr<asio::ssl::context> make_tls_context(const ManagerConfig& config
 }  // namespace
 
 std::unique_ptr<Frontend> make_frontend(asio::io_context& io, const ManagerConfig& config, Supervisor& supervisor,
-                                        Metrics& metrics, const std::string& web_root) {
+                                        Metrics& metrics, const std::string& web_root,
+                                        RegistryClient* registry) {
   if (config.tls_certificate.empty()) {
     auto frontend = std::make_unique<FrontendImpl<websocketpp::config::asio>>(io, config, supervisor, metrics,
-                                                                              web_root, false);
+                                                                              web_root, false, registry);
     frontend->listen();
     return frontend;
   }
   auto context = make_tls_context(config);
   auto frontend = std::make_unique<FrontendImpl<websocketpp::config::asio_tls>>(io, config, supervisor, metrics,
-                                                                                web_root, true);
+                                                                                web_root, true, registry);
   frontend->server().set_tls_init_handler([context](connection_hdl) { return context; });
   frontend->listen();
   return frontend;

@@ -25,10 +25,14 @@ class Frontend {
   virtual void stop() = 0;
 };
 
+class RegistryClient;
+
 /// Listens on the config's address and port, with TLS when the config names a certificate and key.
-/// Registers itself as the supervisor's listener. Throws std::runtime_error naming the cause (address in
-/// use, unreadable certificate or key).
+/// Registers itself as the supervisor's listener. `registry` (may be null: a single host) decides the home of
+/// a uid this host has no session of before /start starts one; it must outlive the frontend. Throws
+/// std::runtime_error naming the cause (address in use, unreadable certificate or key).
 std::unique_ptr<Frontend> make_frontend(boost::asio::io_context& io, const ManagerConfig& config,
-                                        Supervisor& supervisor, Metrics& metrics, const std::string& web_root);
+                                        Supervisor& supervisor, Metrics& metrics, const std::string& web_root,
+                                        RegistryClient* registry = nullptr);
 
 }  // namespace rfbsim::manager

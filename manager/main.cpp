@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -15,10 +16,13 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "agent_check.hpp"
 #include "config.hpp"
 #include "frontend.hpp"
 #include "link_signature.hpp"
 #include "metrics.hpp"
+#include "registry_client.hpp"
+#include "registry_server.hpp"
 #include "session_index.hpp"
 #include "start_request.hpp"
 #include "supervisor.hpp"
@@ -155,7 +159,35 @@ int run(ManagerConfig config) {
   }
   // Before the first link: the index says what happened to the previous run's sessions.
   supervisor.flush_index();
-  const auto frontend = manager::make_frontend(io, config, supervisor, metrics, web_root);
+  // Several hosts: this host's acceptor of the uid registry, and its claimer, which /start asks before it
+  // starts a session of a uid new here (docs/architecture.md, "uid registry").
+  std::unique_ptr<manager::RegistryServer> registry_server;
+  std::unique_ptr<manager::RegistryClient> registry_client;
+  if (!config.cluster_peers.empty()) {
+    const std::string secret = manager::read_cluster_secret(config.cluster_secret_file);
+    const auto self = std::find_if(config.cluster_peers.begin(), config.cluster_peers.end(),
+                                   [&](const manager::ClusterPeer& peer) { return peer.id == config.host_id; });
+    const std::string registry_address = config.registry_bind.empty() ? config.listen_address : config.registry_bind;
+    registry_server = std::make_unique<manager::RegistryServer>(
+        io, registry_address, self->port, secret, (std::filesystem::path(config.data_dir) / "sessions.db").string());
+    registry_client = std::make_unique<manager::RegistryClient>(io, config.cluster_peers, config.host_id, secret,
+                                                                *registry_server);
+    std::fprintf(stderr, "[manager] uid registry on %s:%d, host %s of %zu\n", registry_address.c_str(),
+                 registry_server->port(), config.host_id.c_str(), config.cluster_peers.size());
+  }
+  const auto frontend = manager::make_frontend(io, config, supervisor, metrics, web_root, registry_client.get());
+  // HAProxy's agent-check: asked on every check, so its line always says the load of that moment. It stays up
+  // through a shutdown (saying drain) until the I/O loop stops.
+  std::unique_ptr<manager::AgentCheckServer> agent;
+  if (config.agent_port > 0) {
+    const std::string agent_address = config.agent_bind.empty() ? config.listen_address : config.agent_bind;
+    agent = std::make_unique<manager::AgentCheckServer>(io, agent_address, config.agent_port, [&supervisor, &config] {
+      const int live = static_cast<int>(supervisor.table().size());
+      return manager::AgentLoad{config.max_sessions - live, config.max_sessions, supervisor.draining(),
+                                supervisor.shutting_down()};
+    });
+    std::fprintf(stderr, "[manager] HAProxy agent-check on %s:%d\n", agent_address.c_str(), agent->port());
+  }
   // Without signed links the uid is the only secret: anyone who learns or guesses one can start (or take
   // over) that participant's session. Fine on loopback; on a public address it should be a choice.
   if (config.link_secret.empty() && config.listen_address.rfind("127.", 0) != 0) {

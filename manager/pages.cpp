@@ -41,6 +41,22 @@ std::string busy_page(int retry_seconds) {
                 "<meta http-equiv=\"refresh\" content=\"" + seconds + "\">\n");
 }
 
+std::string retry_later_page(int retry_seconds) {
+  const std::string seconds = std::to_string(retry_seconds);
+  return layout("Please try again in a moment",
+                "<p>The study's servers could not agree on a simulator for you just now. This page tries again by "
+                "itself in " + seconds + " seconds; please keep it open.</p>",
+                "<meta http-equiv=\"refresh\" content=\"" + seconds + "\">\n");
+}
+
+std::string previous_closing_page(int retry_seconds) {
+  const std::string seconds = std::to_string(retry_seconds);
+  return layout("Your previous session is closing",
+                "<p>Your earlier session with this link is still closing. This page tries again by itself in " +
+                    seconds + " seconds; please keep it open.</p>",
+                "<meta http-equiv=\"refresh\" content=\"" + seconds + "\">\n");
+}
+
 std::string completed_page() {
   return layout("Already completed",
                 "<p>This link's session has already been completed, and each link can be used once. "

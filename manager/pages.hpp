@@ -14,6 +14,14 @@ std::string home_page();
 /// Every simulator is busy: the page reloads itself (retrying the same link) after `retry_seconds`.
 std::string busy_page(int retry_seconds);
 
+/// Too few hosts of a cluster answered to decide where the uid's session runs: the page reloads itself
+/// (retrying the same link) after `retry_seconds`.
+std::string retry_later_page(int retry_seconds);
+
+/// The uid's own earlier session is still closing: the page reloads itself after `retry_seconds`. Not the
+/// busy page: nothing else is wrong, and the participant must come back to this host.
+std::string previous_closing_page(int retry_seconds);
+
 /// The uid's session already ran its course.
 std::string completed_page();
 

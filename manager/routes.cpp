@@ -48,8 +48,25 @@ bool is_token(std::string_view text) {
   return true;
 }
 
-Route route_request(std::string_view method, std::string_view target) {
-  const auto [path, query] = split_target(target);
+bool is_path_prefix(std::string_view text) {
+  if (text.size() < 2 || text.size() > 33 || text.front() != '/') return false;
+  for (const char ch : text.substr(1)) {
+    if (!((ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '-')) return false;
+  }
+  return true;
+}
+
+std::string_view strip_path_prefix(std::string_view path, std::string_view path_prefix) {
+  if (path_prefix.empty() || path.rfind(path_prefix, 0) != 0) return path;
+  const std::string_view rest = path.substr(path_prefix.size());
+  if (rest.empty()) return "/";
+  // "/h2x/..." is not under "/h2": the prefix must end at a segment boundary.
+  return rest.front() == '/' ? rest : path;
+}
+
+Route route_request(std::string_view method, std::string_view target, std::string_view path_prefix) {
+  const auto [full_path, query] = split_target(target);
+  const std::string_view path = strip_path_prefix(full_path, path_prefix);
   Route route;
   route.query = std::string(query);
   if (path == "/") {
@@ -85,6 +102,14 @@ Route route_request(std::string_view method, std::string_view target) {
   }
   if (path == "/api/sessions") {
     route.kind = RouteKind::kApiSessions;
+    return with_method(route, method, "GET");
+  }
+  if (path == "/api/drain" || path == "/api/undrain") {
+    route.kind = path == "/api/drain" ? RouteKind::kApiDrain : RouteKind::kApiUndrain;
+    return with_method(route, method, "POST");
+  }
+  if (path == "/api/host" || path == "/api/cluster") {
+    route.kind = path == "/api/host" ? RouteKind::kApiHost : RouteKind::kApiCluster;
     return with_method(route, method, "GET");
   }
   constexpr std::string_view kApiPrefix = "/api/sessions/";

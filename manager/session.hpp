@@ -87,6 +87,11 @@ struct Session {
   std::optional<WallTime> spent_at;
   /// Why the session's recorded data is incomplete, as the program reported it (a full disk...); "" = complete.
   std::string data_incomplete;
+  /// The after-session copy of the session's folder (after_session_command): "" none configured, "pending",
+  /// "done" or "failed"; its tries so far; its last failure in words ("" when done).
+  std::string copy_state;
+  int copy_attempts = 0;
+  std::string copy_error;
   /// The client address /start came from, for the per-address limit on unspent sessions. Kept in memory only:
   /// participants' addresses are not part of the study's record.
   std::string start_address;

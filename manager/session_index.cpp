@@ -36,15 +36,26 @@ CREATE TABLE IF NOT EXISTS sessions (
   ready_at      TEXT,
   ended_at      TEXT,
   spent_at      TEXT,                   -- the first picture reached a participant: the link is spent
-  data_incomplete TEXT                  -- why the session's data is incomplete (a full disk...); NULL: complete
+  data_incomplete TEXT,                 -- why the session's data is incomplete (a full disk...); NULL: complete
+  copy_state    TEXT NOT NULL DEFAULT '',  -- after_session_command: '' none, pending, done, failed
+  copy_attempts INTEGER NOT NULL DEFAULT 0,  -- tries of that command so far
+  copy_error    TEXT NOT NULL DEFAULT ''   -- its last failure ("exit 23: ..."); '' when done
 );
 CREATE INDEX IF NOT EXISTS sessions_by_uid ON sessions (uid, id);
 CREATE INDEX IF NOT EXISTS sessions_by_state ON sessions (state);
+-- The uid registry's record (several hosts, manager/uid_registry.hpp): the home this host, as an acceptor,
+-- answered for each uid it was asked about. A row, once committed, never changes.
+CREATE TABLE IF NOT EXISTS uid_homes (
+  uid        TEXT PRIMARY KEY,
+  host       TEXT NOT NULL,
+  claimed_at TEXT                       -- ISO 8601 UTC
+);
 )sql";
 
 constexpr const char* kColumns =
     "id, uid, token, scenario, params, seed, host_id, state, detail, exit_status, pid, process_start, port, "
-    "data_path, created_at, ready_at, ended_at, outcome, code_success, code_timeout, spent_at, data_incomplete";
+    "data_path, created_at, ready_at, ended_at, outcome, code_success, code_timeout, spent_at, data_incomplete, "
+    "copy_state, copy_attempts, copy_error";
 
 // One prepared statement, finalized on scope exit.
 class Statement {
@@ -113,6 +124,9 @@ Session read_row(Statement& row) {
   s.code_timeout = row.text(19);
   if (!row.is_null(20)) s.spent_at = parse_iso_utc(row.text(20));
   s.data_incomplete = row.text(21);
+  s.copy_state = row.text(22);
+  s.copy_attempts = static_cast<int>(row.integer(23));
+  s.copy_error = row.text(24);
   return s;
 }
 
@@ -179,11 +193,13 @@ void SessionIndex::add_missing_columns() {
   // index across an upgrade.
   bool has_codes = false;
   bool has_spent = false;
+  bool has_copy = false;
   {
     Statement columns(db_, "PRAGMA table_info(sessions)");
     while (columns.step()) {
       has_codes = has_codes || columns.text(1) == "code_success";
       has_spent = has_spent || columns.text(1) == "spent_at";
+      has_copy = has_copy || columns.text(1) == "copy_state";
     }
   }
   if (!has_codes) {
@@ -193,6 +209,11 @@ void SessionIndex::add_missing_columns() {
   if (!has_spent) {
     exec("ALTER TABLE sessions ADD COLUMN spent_at TEXT");
     exec("ALTER TABLE sessions ADD COLUMN data_incomplete TEXT");
+  }
+  if (!has_copy) {
+    exec("ALTER TABLE sessions ADD COLUMN copy_state TEXT NOT NULL DEFAULT ''");
+    exec("ALTER TABLE sessions ADD COLUMN copy_attempts INTEGER NOT NULL DEFAULT 0");
+    exec("ALTER TABLE sessions ADD COLUMN copy_error TEXT NOT NULL DEFAULT ''");
   }
 }
 
@@ -247,7 +268,8 @@ void SessionIndex::update(const Session& s) {
   Statement update(db_,
                    "UPDATE sessions SET state = ?, detail = ?, exit_status = ?, pid = ?, process_start = ?, "
                    "port = ?, data_path = ?, ready_at = ?, ended_at = ?, outcome = ?, spent_at = ?, "
-                   "data_incomplete = ? WHERE id = ?");
+                   "data_incomplete = ?, copy_state = CASE WHEN copy_state = '' THEN ? ELSE copy_state END "
+                   "WHERE id = ?");
   update.bind(1, std::string(state_name(s.state)));
   update.bind(2, s.detail);
   update.bind(3, s.exit_status);
@@ -268,7 +290,10 @@ void SessionIndex::update(const Session& s) {
   } else {
     update.bind(12, s.data_incomplete);
   }
-  update.bind(13, s.id);
+  // The copy columns belong to the copier (set_copy_status); an update only starts a copy, as 'pending' in the
+  // same transaction as the session's end, so that a crash in between cannot lose it.
+  update.bind(13, s.copy_state);
+  update.bind(14, s.id);
   update.step();
   if (sqlite3_changes(db_) != 1) {
     throw std::runtime_error("session index: no session " + std::to_string(s.id) + " to update");
@@ -299,8 +324,43 @@ std::vector<Session> SessionIndex::live_sessions(const std::string& host_id) {
   return query("WHERE host_id = ? AND state IN ('starting', 'running', 'ending') ORDER BY id", {host_id});
 }
 
+void SessionIndex::set_copy_status(std::int64_t id, const std::string& state, int attempts, const std::string& error) {
+  Statement update(db_, "UPDATE sessions SET copy_state = ?, copy_attempts = ?, copy_error = ? WHERE id = ?");
+  update.bind(1, state);
+  update.bind(2, static_cast<std::int64_t>(attempts));
+  update.bind(3, error);
+  update.bind(4, id);
+  update.step();
+  if (sqlite3_changes(db_) != 1) {
+    throw std::runtime_error("session index: no session " + std::to_string(id) + " to record a copy for");
+  }
+}
+
+std::vector<Session> SessionIndex::pending_copies(const std::string& host_id) {
+  return query("WHERE host_id = ? AND copy_state = 'pending' ORDER BY id", {host_id});
+}
+
 std::vector<Session> SessionIndex::recent(int limit) {
   return query("ORDER BY id DESC LIMIT " + std::to_string(limit), {});
+}
+
+std::string SessionIndex::claim_uid_home(const std::string& uid, const std::string& host, WallTime claimed_at) {
+  // OR IGNORE keeps the first record: an acceptor answers one home per uid, forever.
+  Statement insert(db_, "INSERT OR IGNORE INTO uid_homes (uid, host, claimed_at) VALUES (?,?,?)");
+  insert.bind(1, uid);
+  insert.bind(2, host);
+  insert.bind(3, iso_utc(claimed_at));
+  insert.step();
+  const auto home = uid_home(uid);
+  if (!home) throw std::runtime_error("session index: uid_homes lost the record of " + uid);
+  return *home;
+}
+
+std::optional<std::string> SessionIndex::uid_home(const std::string& uid) {
+  Statement select(db_, "SELECT host FROM uid_homes WHERE uid = ?");
+  select.bind(1, uid);
+  if (!select.step()) return std::nullopt;
+  return select.text(0);
 }
 
 std::vector<std::pair<SessionState, std::int64_t>> SessionIndex::count_by_state() {

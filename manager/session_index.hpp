@@ -35,8 +35,14 @@ class SessionIndex {
   /// The file this index lives in.
   [[nodiscard]] const std::string& path() const { return path_; }
   /// Writes a session's mutable fields (state, detail, exit status, pid, process start, port, data path,
-  /// times) to its row.
+  /// times) to its row; session.copy_state only where the row has none yet (a copy starts as 'pending'; from
+  /// then on the copy columns are set_copy_status's alone).
   void update(const Session& session);
+  /// Records a session's after-session copy: its state ("pending", "done", "failed"), tries so far and last
+  /// failure. Throws std::runtime_error when there is no such session.
+  void set_copy_status(std::int64_t id, const std::string& state, int attempts, const std::string& error);
+  /// This host's sessions whose copy is 'pending', oldest first: after a restart, the copies to try again.
+  std::vector<Session> pending_copies(const std::string& host_id);
 
   /// The latest session of a uid, if any.
   std::optional<Session> latest_for_uid(const std::string& uid);
@@ -49,6 +55,12 @@ class SessionIndex {
   std::vector<Session> recent(int limit);
   /// Sessions per state over the whole index.
   std::vector<std::pair<SessionState, std::int64_t>> count_by_state();
+
+  /// The uid registry's acceptor: records `host` as `uid`'s home unless the uid has one, and returns the
+  /// home recorded (committed before it returns; throws std::runtime_error on index errors).
+  std::string claim_uid_home(const std::string& uid, const std::string& host, WallTime claimed_at);
+  /// The home recorded for `uid`, if any.
+  std::optional<std::string> uid_home(const std::string& uid);
 
  private:
   std::vector<Session> query(const std::string& where, const std::vector<std::string>& binds);

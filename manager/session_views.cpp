@@ -45,7 +45,10 @@ std::string session_json(const Session& s, bool include_token) {
                      json_escape(s.exit_status) + "\",\"created_at\":\"" + iso_utc(s.created) +
                      "\",\"ready_at\":" + time(s.ready_at) + ",\"ended_at\":" + time(s.ended_at) +
                      ",\"data_path\":\"" + json_escape(s.data_path) + "\",\"outcome\":" +
-                     (s.outcome.empty() ? std::string("null") : "\"" + json_escape(s.outcome) + "\"") + ",\"params\":" +
+                     (s.outcome.empty() ? std::string("null") : "\"" + json_escape(s.outcome) + "\"") +
+                     ",\"copy_state\":\"" + json_escape(s.copy_state) + "\",\"copy_attempts\":" +
+                     std::to_string(s.copy_attempts) + ",\"copy_error\":\"" + json_escape(s.copy_error) +
+                     "\",\"params\":" +
                      (s.params_json.empty() ? "{}" : s.params_json);
   // The stream as sim_rfb last told it; null for what it did not say and when nobody watches.
   const auto decimal = [](const std::optional<double>& value) {
@@ -68,7 +71,8 @@ std::string session_record_json(const Session& s) {
   const auto text_or_null = [](const std::string& text) {
     return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\"";
   };
-  return "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"state\":\"" +
+  return "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"host\":\"" +
+         json_escape(s.host_id) + "\",\"state\":\"" +
          state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"created_at\":\"" + iso_utc(s.created) +
          "\",\"ready_at\":" + time(s.ready_at) + ",\"spent_at\":" + time(s.spent_at) + ",\"ended_at\":" +
          time(s.ended_at) + ",\"outcome\":" + text_or_null(s.outcome) +

@@ -26,6 +26,7 @@ CloseNotice close_notice(SessionState state);
 std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins);
 
 /// One session for the admin API: id, uid, scenario, seed, state, detail, exit status, times, data path, the
+/// after-session copy ("copy_state": "" | "pending" | "done" | "failed", "copy_attempts", "copy_error"), the
 /// link's parameters, and the participant's stream: "codec" ("tight", "h264"), "rtt_ms" (1 decimal) and "fps"
 /// (1 decimal), each null when unknown or nobody watches; the token only when `include_token` (live sessions,
 /// which a researcher may watch).

@@ -127,6 +127,18 @@ Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::s
     if (!is_live(state)) ended_counts_[state] = count;
   }
   wait_for_children();
+  if (!config_.after_session_command.empty()) {
+    CopierSettings copy;
+    copy.command = config_.after_session_command;
+    copy.retries = config_.after_session_retries;
+    copy.timeout = config_.after_session_timeout;
+    copy.kill_grace = config_.stop_grace;
+    copy.index_path = index_.path();
+    copy.log_dir = (std::filesystem::absolute(config_.data_dir) / "copy-logs").string();
+    copier_ = std::make_unique<SessionCopier>(std::move(copy));
+    // Copies the previous manager left unfinished (it stopped or died meanwhile) are tried again.
+    for (const Session& session : index_.pending_copies(config_.host_id)) copier_->enqueue(copy_job_for(session));
+  }
 }
 
 Supervisor::~Supervisor() {
@@ -182,6 +194,10 @@ std::optional<Session> Supervisor::latest_for_uid(const std::string& uid) {
   return latest;
 }
 
+bool Supervisor::has_session_for_uid(const std::string& uid) {
+  return table_.by_uid(uid) != nullptr || latest_for_uid(uid).has_value();
+}
+
 int Supervisor::recover_interrupted() {
   std::vector<Session> left;
   try {
@@ -205,7 +221,7 @@ int Supervisor::recover_interrupted() {
     session.state = SessionState::kInterrupted;
     session.detail = "the manager stopped unexpectedly while the session ran";
     session.ended_at = std::chrono::system_clock::now();
-    save(session);
+    save(session, copy_after_commit(session));
     ++ended_counts_[SessionState::kInterrupted];
   }
   return static_cast<int>(left.size());
@@ -215,7 +231,7 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
   StartOutcome outcome;
   Session* live = table_.by_uid(request.uid);
   if (live != nullptr && live->state == SessionState::kEnding) {
-    outcome.kind = StartOutcome::Kind::kBusy;  // a few seconds from gone: the busy page retries
+    outcome.kind = StartOutcome::Kind::kPreviousEnding;  // a few seconds from gone: the page retries here
     reply(outcome);
     return;
   }
@@ -229,7 +245,7 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
       return;
     }
   }
-  switch (admit(live != nullptr, last, config_.allow_repeat, table_.full() || shutting_down_)) {
+  switch (admit(live != nullptr, last, config_.allow_repeat, table_.full() || shutting_down_ || draining_)) {
     case Admission::kJoinLive:
       outcome.kind = StartOutcome::Kind::kJoined;
       outcome.token = live->token;
@@ -590,6 +606,8 @@ void Supervisor::reap_children() {
   for (;;) {
     siginfo_t info{};
     if (::waitid(P_ALL, 0, &info, WEXITED | WNOHANG | WNOWAIT) != 0 || info.si_pid == 0) return;
+    // The after-session copier's command is its own to reap (it waits for that pid alone).
+    if (copier_ && copier_->may_own(info.si_pid)) return;
     if (!reap_if_exited(info.si_pid)) return;
   }
 }
@@ -606,6 +624,14 @@ bool Supervisor::reap_if_exited(pid_t pid) {
   if (::waitpid(pid, &status, 0) != pid) return false;
   if (Session* session = table_.by_pid(pid)) process_gone(*session, status);
   return true;
+}
+
+std::function<void(const std::string&)> Supervisor::copy_after_commit(Session& session) {
+  std::error_code ec;
+  if (!copier_ || session.data_path.empty() || !std::filesystem::is_directory(session.data_path, ec)) return nullptr;
+  session.copy_state = "pending";
+  // Queued even when the index refused the row: the copy of the data matters more than its record.
+  return [this, job = copy_job_for(session)](const std::string&) { copier_->enqueue(job); };
 }
 
 std::string Supervisor::session_log_tail(const Session& session) const {
@@ -636,7 +662,7 @@ void Supervisor::process_gone(Session& session, int wait_status) {
     std::error_code ignored;
     std::filesystem::remove(session.unix_socket, ignored);
   }
-  save(session);
+  save(session, copy_after_commit(session));
   log_session(session, std::string(state_name(final_state)) + " (" + session.exit_status + ")");
   if (listener_ != nullptr) listener_->session_closing(session);
   const std::int64_t id = session.id;

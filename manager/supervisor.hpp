@@ -18,6 +18,7 @@
 #include "index_writer.hpp"
 #include "process_launcher.hpp"
 #include "metrics.hpp"
+#include "session_copier.hpp"
 #include "session_index.hpp"
 #include "session_table.hpp"
 #include "start_request.hpp"
@@ -38,7 +39,10 @@ class SessionListener {
 struct StartOutcome {
   /// kTooManyUnspent: the address already started abuse.unspent_sessions_per_address sessions that no
   /// participant has seen yet.
-  enum class Kind { kJoined, kStarted, kBusy, kCompleted, kFailed, kTooManyUnspent } kind = Kind::kFailed;
+  /// kPreviousEnding: the uid's own session is still ending (seconds from gone); not kBusy, so that nobody
+  /// retries on another host, where a second session of the uid would start.
+  enum class Kind { kJoined, kStarted, kBusy, kCompleted, kFailed, kTooManyUnspent, kPreviousEnding } kind =
+      Kind::kFailed;
   std::string token;    ///< kJoined, kStarted
   std::string message;  ///< kFailed: why, for the log and the page
 };
@@ -65,6 +69,11 @@ class Supervisor {
   /// writer's thread, posted back), so that a redirect always points at a recorded session.
   void start(const StartRequest& request, const std::string& address, StartReply reply);
 
+  /// Whether this host has any session of `uid`, live or ended, in its table, the index or the writes still
+  /// queued: such a uid's /start is this host's to answer, without asking the uid registry. Throws
+  /// std::runtime_error when the index cannot be read.
+  bool has_session_for_uid(const std::string& uid);
+
   /// A browser connected to / disconnected from a session (the idle timer counts from the last one gone).
   void client_connected(std::int64_t id);
   void client_disconnected(std::int64_t id);
@@ -78,6 +87,14 @@ class Supervisor {
 
   /// Ends every session and calls `done` once all processes are gone (SIGKILL after the grace period).
   void shutdown(std::function<void()> done);
+
+  /// Takes no new participants (true) or takes them again (false): live sessions and their uids' rejoins go
+  /// on, and a /start of any other uid is answered kBusy, like a full host, so a balancer may send it elsewhere.
+  void set_draining(bool draining) { draining_ = draining; }
+  /// Whether set_draining(true) is in force.
+  [[nodiscard]] bool draining() const { return draining_; }
+  /// Whether shutdown() was called: the sessions are ending and no new one starts.
+  [[nodiscard]] bool shutting_down() const { return shutting_down_; }
 
   /// Live sessions.
   SessionTable& table() { return table_; }
@@ -125,6 +142,9 @@ class Supervisor {
   // The uid's newest session in the index or among writes still queued.
   std::optional<Session> latest_for_uid(const std::string& uid);
   std::string session_log_tail(const Session& session) const;
+  // For the save that makes `session`'s folder final: marks its after-session copy 'pending' (in that same row)
+  // and returns what queues the copy once the row and manager.json are written; nullptr without a copier or folder.
+  std::function<void(const std::string&)> copy_after_commit(Session& session);
   Runtime& runtime(std::int64_t id);
 
   boost::asio::io_context& io_;
@@ -139,11 +159,14 @@ class Supervisor {
   std::unique_ptr<ChildWatch> child_watch_;
   std::function<void()> on_all_gone_;  // set by shutdown()
   bool shutting_down_ = false;
+  bool draining_ = false;  // set_draining
   std::string socket_dir_;  // private folder (0700) of the sessions' unix sockets; "" = they use TCP ports
   std::unique_ptr<IndexWriter> writer_;  // the index's writes, off this thread
   // Session starts, off this thread; its thread must outlive the sessions it started (PR_SET_PDEATHSIG).
   std::unique_ptr<ProcessLauncher> launcher_;
   int launches_in_flight_ = 0;  // starts queued or running on the launcher, whose pids the table lacks yet
+  // after_session_command's runs, on a thread of their own; null without one. It reaps its own child.
+  std::unique_ptr<SessionCopier> copier_;
   std::int64_t next_id_ = 1;             // session ids are handed out here, above the index's highest
   // Sessions whose latest version is queued for the writer, by id: (write sequence, that version). Reads of
   // the index look here first, so that they never see an older row than the table did.

@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// rfbsim admin page logic: lists sim_manager's live and recent sessions from /api/sessions every 2 s and ends a
-// session on request. The page and the API share one origin, so the browser resends the admin credentials (HTTP
-// Basic, the token as password) by itself.
+// rfbsim admin page logic: lists sim_manager's live and recent sessions from api/sessions every 2 s, ends a
+// session on request, drains this host (no new participants) or takes it back, and in a cluster lists every host's
+// live sessions. The page and the API share one origin, so the browser resends the admin credentials (HTTP Basic,
+// the token as password) by itself. Every address is relative to the page (/admin, or /h2/admin under a host's path
+// prefix behind a balancer), so the page works under any prefix.
 
-const API = '/api/sessions';
+const API = 'api/sessions';
 const REFRESH_MS = 2000;
+// The cluster view asks every host, through the balancer, less often than this host's own tables.
+const CLUSTER_API = 'api/cluster';
+const CLUSTER_REFRESH_MS = 5000;
 
 // ---------------------------------------------------------------------------------------------------------------
 // Page elements (all exist in admin.html).
@@ -16,6 +21,12 @@ const ui = {
   liveEmpty: document.getElementById('live-empty'),
   recent: document.querySelector('#recent tbody'),
   recentEmpty: document.getElementById('recent-empty'),
+  hostState: document.getElementById('host-state'),
+  drain: document.getElementById('drain'),
+  clusterSection: document.getElementById('cluster-section'),
+  clusterHosts: document.querySelector('#cluster-hosts tbody'),
+  clusterSessions: document.querySelector('#cluster-sessions tbody'),
+  clusterEmpty: document.getElementById('cluster-empty'),
 };
 
 // State, also readable by tests as window.rfbsimAdminState (read-only by convention).
@@ -23,6 +34,9 @@ const state = {
   updates: 0,         // answers from the API shown so far
   error: null,        // what went wrong with the last request, in words, or null
   lastUpdate: null,   // Date of the last answer shown
+  draining: null,     // this host takes no new participants (true), takes them (false), or not known yet (null)
+  cluster: null,      // the last cluster view: [{ id, prefix, reachable, error, draining, live, capacity }], or null
+                      //   where this host is alone
 };
 window.rfbsimAdminState = state;
 
@@ -170,7 +184,9 @@ function updateLiveRow(row, session, now) {
   setText(c[8], formatNumber(session.fps, ''));
   setText(c[9], session.data_path);
   const [watch, end] = c[10].children;
-  const href = session.token ? `/admin/watch/${encodeURIComponent(session.token)}/` : '';
+  // Relative to this page (its path prefix included), written out as a path so that it reads plainly.
+  const href = session.token
+    ? new URL(`admin/watch/${encodeURIComponent(session.token)}/`, document.baseURI).pathname : '';
   if (watch.getAttribute('href') !== href) {
     watch.setAttribute('href', href);
   }
@@ -182,9 +198,22 @@ function updateLiveRow(row, session, now) {
   }
 }
 
-// Recent (ended) sessions: id, participant, scenario, state, started, ended, duration, detail, exit status, folder.
+// Recent (ended) sessions: id, participant, scenario, state, started, ended, duration, detail, exit status, folder,
+// copied.
 function makeRecentRow(session) {
-  return makeRow(session.id, ['num', '', '', '', 'time', 'time', 'num', '', '', 'path']);
+  return makeRow(session.id, ['num', '', '', '', 'time', 'time', 'num', '', '', 'path', '']);
+}
+
+// The after-session copy ("copy_state", "copy_attempts", "copy_error" from the API) in words: '\u2013' when none
+// is configured, else its state and tries, with the last failure as the cell's tooltip.
+function formatCopy(session) {
+  const tries = session.copy_attempts === 1 ? '1 try' : `${session.copy_attempts} tries`;
+  switch (session.copy_state) {
+    case 'done': return session.copy_attempts > 1 ? `yes (${tries})` : 'yes';
+    case 'pending': return session.copy_attempts > 0 ? `pending (${tries} failed)` : 'pending';
+    case 'failed': return `FAILED (${tries})`;
+    default: return DASH;
+  }
 }
 
 function updateRecentRow(row, session) {
@@ -200,6 +229,10 @@ function updateRecentRow(row, session) {
   setText(c[7], session.detail || '');
   setText(c[8], session.exit_status || '');
   setText(c[9], session.data_path);
+  setText(c[10], formatCopy(session));
+  if (c[10].title !== (session.copy_error || '')) {
+    c[10].title = session.copy_error || '';
+  }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -225,6 +258,137 @@ function render(data) {
   const time = formatTime(state.lastUpdate.toISOString());
   setText(ui.summary, `${live.length} of ${data.capacity} session slots in use \u00b7 updated ${time} ` +
                       `(every ${REFRESH_MS / 1000} s)`);
+  showDraining(data.draining === true);
+}
+
+// ---------------------------------------------------------------------------------------------------------------
+// Drain: the balancer's health and agent checks then send this host no new participants, while its live sessions
+// (and their participants' rejoins) go on. The button switches it; the line says which way it stands.
+// ---------------------------------------------------------------------------------------------------------------
+function showDraining(draining) {
+  state.draining = draining;
+  setText(ui.hostState, draining
+    ? 'Draining: this host takes no new sessions; its live ones go on.'
+    : 'This host takes new sessions.');
+  ui.hostState.className = draining ? 'draining' : '';
+  setText(ui.drain, draining ? 'Take new sessions' : 'Drain this host');
+  ui.drain.hidden = false;
+}
+
+async function switchDraining() {
+  const drain = state.draining !== true;
+  if (drain && !window.confirm('Drain this host? It takes no new sessions until you take it back; live sessions ' +
+                               'go on.')) {
+    return;
+  }
+  ui.drain.disabled = true;
+  try {
+    // The custom header proves the request comes from this page, as for End.
+    const response = await fetch(drain ? 'api/drain' : 'api/undrain', {
+      method: 'POST',
+      cache: 'no-store',
+      headers: { 'X-Rfbsim-Admin': '1' },
+    });
+    if (response.ok) {
+      const host = await response.json();
+      showDraining(host.draining === true);
+      showMessage(host.draining ? 'This host is draining: no new sessions.' : 'This host takes new sessions again.',
+                  'info');
+    } else {
+      showMessage(await describeFailure(response, drain ? 'drain this host' : 'take new sessions'), 'error');
+    }
+  } catch (err) {
+    showMessage(`Could not switch draining: the server cannot be reached (${err.message}).`, 'error');
+  }
+  ui.drain.disabled = false;
+}
+
+ui.drain.addEventListener('click', switchDraining);
+
+// ---------------------------------------------------------------------------------------------------------------
+// The cluster view: api/cluster names every host and its path prefix on the balancer's origin; each host's
+// api/sessions is asked there. A host that does not answer (down, or the balancer's 503) is shown as unreachable.
+// ---------------------------------------------------------------------------------------------------------------
+
+// The balancer's root path: this page's folder less this host's own prefix ("/h2/" -> "/").
+function clusterRoot(ownPrefix) {
+  const folder = new URL('.', document.baseURI).pathname;
+  const own = `${ownPrefix || ''}/`;
+  return ownPrefix && folder.endsWith(own) ? folder.slice(0, folder.length - own.length + 1) : folder;
+}
+
+// One host's live sessions and load, or why they could not be had.
+async function fetchHost(root, host) {
+  const url = `${root}${host.prefix ? `${host.prefix.slice(1)}/` : ''}api/sessions`;
+  const view = { id: host.id, prefix: host.prefix, reachable: false, error: '', draining: false, live: [],
+                 capacity: null };
+  try {
+    const response = await fetch(url, { cache: 'no-store', headers: { Accept: 'application/json' } });
+    if (!response.ok) {
+      view.error = `HTTP ${response.status}`;
+      return view;
+    }
+    const data = await response.json();
+    view.reachable = true;
+    view.draining = data.draining === true;
+    view.live = Array.isArray(data.live) ? data.live : [];
+    view.capacity = Number.isFinite(data.capacity) ? data.capacity : null;
+  } catch (err) {
+    view.error = err.message;
+  }
+  return view;
+}
+
+function renderCluster(hosts) {
+  syncRows(ui.clusterHosts, hosts, (host) => makeRow(host.id, ['', '', 'num']),
+           (row, host) => {
+             const c = row.cells;
+             setText(c[0], host.id);
+             const words = !host.reachable ? `unreachable (${host.error})` : host.draining ? 'draining' : 'up';
+             setText(c[1], words);
+             c[1].className = !host.reachable ? 'unreachable' : host.draining ? 'draining' : '';
+             setText(c[2], host.reachable ? `${host.live.length} of ${host.capacity ?? '?'}` : DASH);
+           });
+  const sessions = hosts.flatMap((host) => host.live.map((s) => ({ ...s, host: host.id, id: `${host.id}/${s.id}`,
+                                                                   number: s.id })));
+  syncRows(ui.clusterSessions, sessions, (s) => makeRow(s.id, ['', 'num', '', '', '', 'time']), (row, s) => {
+    const c = row.cells;
+    setText(c[0], s.host);
+    setText(c[1], String(s.number));
+    setText(c[2], s.uid);
+    setText(c[3], s.scenario);
+    setState(c[4], s.state, '');
+    setText(c[5], formatTime(s.created_at));
+  });
+  ui.clusterEmpty.hidden = sessions.length > 0;
+}
+
+async function refreshCluster() {
+  let cluster;
+  try {
+    const response = await fetch(CLUSTER_API, { cache: 'no-store', headers: { Accept: 'application/json' } });
+    if (!response.ok) {
+      return;   // an older manager without the cluster API, or not authorised: the main tables say so
+    }
+    cluster = await response.json();
+  } catch (err) {
+    return;
+  }
+  const hosts = Array.isArray(cluster.hosts) ? cluster.hosts : [];
+  if (hosts.length < 2) {
+    state.cluster = null;
+    ui.clusterSection.hidden = true;
+    return;
+  }
+  const root = clusterRoot(typeof cluster.prefix === 'string' ? cluster.prefix : '');
+  state.cluster = await Promise.all(hosts.map((host) => fetchHost(root, host)));
+  renderCluster(state.cluster);
+  ui.clusterSection.hidden = false;
+}
+
+async function clusterLoop() {
+  await refreshCluster();
+  setTimeout(clusterLoop, CLUSTER_REFRESH_MS);
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -301,3 +465,4 @@ async function refreshLoop() {
 }
 
 refreshLoop();
+clusterLoop();

@@ -82,9 +82,10 @@ const options = {
 };
 state.options = options;
 
-// A researcher watching from the admin page (/admin/watch/<token>/): the manager drops this page's keys
-// and pointer anyway; here the view is read-only and never invites anyone to walk.
-const watching = window.location.pathname.startsWith('/admin/watch/');
+// A researcher watching from the admin page (/admin/watch/<token>/, or under a host's path prefix behind a balancer,
+// /h2/admin/watch/<token>/): the manager drops this page's keys and pointer anyway; here the view is read-only and
+// never invites anyone to walk.
+const watching = /\/admin\/watch\/[0-9a-f]{32}\/[^/]*$/.test(window.location.pathname);
 state.watching = watching;
 
 // The survey around this page (if any) hears how the session goes; a researcher's watching page tells no one.
@@ -131,6 +132,11 @@ const SESSION_OVER_WORDS = {
   interrupted: 'The session was interrupted.',
   abandoned: 'The session ended before its picture could reach this browser.',
 };
+// Behind a balancer, the status of a session whose host went down is answered by the balancer itself: HTTP 410 with
+// {"state": "lost"}. Nothing on this page can bring it back, and the link should not be opened again blindly.
+const SESSION_LOST_TITLE = 'Session lost';
+const SESSION_LOST_WORDS = 'The server running your session stopped. Please go back to the survey and tell the ' +
+                           'researcher.';
 // Sessions that did not run their course: the study link starts a new one.
 const RESTARTABLE_STATES = new Set(['shutdown', 'crashed', 'failed', 'interrupted', 'abandoned']);
 
@@ -139,6 +145,7 @@ let noStatusView = 'none';   // what an unavailable status means: 'none' (sim_rf
 let managed = false;         // a manager has answered this page's status at least once
 let statusPolling = false;   // the polling loop runs
 let startingSince = null;    // { elapsedS, at }: the session's start-up time as last reported, and when
+let sessionLost = false;     // the balancer said this session's host is gone (see SESSION_LOST_WORDS)
 
 function timeoutSignal(ms) {
   return typeof AbortSignal.timeout === 'function' ? AbortSignal.timeout(ms) : undefined;
@@ -167,6 +174,10 @@ async function fetchSessionStatus() {
   const valid = response.ok && body !== null && typeof body === 'object' && typeof body.state === 'string';
   const view = sessionView({ httpStatus: response.status, json, state: valid ? body.state : null, managed });
   if (!valid) {
+    if (json && body !== null && typeof body === 'object' && body.state === 'lost') {
+      sessionLost = true;
+      state.sessionState = 'lost';
+    }
     // sim_rfb serving the page itself answers 404 (text); a manager answers JSON, and 404 or 410 once it no longer
     // knows the session. Either way there is nothing more to ask. Server errors may pass: asked again later.
     if (view === 'none' || view === 'gone') {
@@ -634,6 +645,15 @@ async function finishAttempt(info, { view = null, hadFocus = false } = {}) {
   // Over for good when the manager says the session is neither starting nor running, or no longer knows it: a
   // reconnect cannot help.
   const session = await fetchSessionStatus();
+  if (session.view === 'gone' && sessionLost) {
+    survey.ended();
+    recovery = null;
+    stopReconnecting();
+    endRecovery();
+    state.lastDisconnect = { ...info, kind: 'ended', final: true, sessionState: 'lost', message: SESSION_LOST_WORDS };
+    showDisconnected(SESSION_LOST_TITLE, SESSION_LOST_WORDS, true);
+    return;
+  }
   if (session.view === 'over' || session.view === 'gone') {
     let message;
     if (session.view === 'gone') {

@@ -201,3 +201,70 @@ TEST_CASE("watch paths without a valid token are not found, and never the admin 
   CHECK(kind("GET", "/admin/watching/" + kToken + "/") == RouteKind::kAdminPage);
   CHECK(kind("GET", "/s/" + kToken + "/admin/watch/" + kToken + "/ws") == RouteKind::kSessionFile);
 }
+
+TEST_CASE("a path under the manager's prefix routes as the path without it") {
+  const auto page = route_request("GET", "/h2/s/" + kToken + "/", "/h2");
+  CHECK(page.kind == RouteKind::kSessionFile);
+  CHECK(page.token == kToken);
+  CHECK(page.file.empty());
+  CHECK(kind("GET", "/h2/s/" + kToken + "/status") == RouteKind::kNotFound);  // no prefix configured
+  CHECK(route_request("GET", "/h2/s/" + kToken + "/status", "/h2").kind == RouteKind::kSessionStatus);
+  const auto ws = route_request("GET", "/h2/s/" + kToken + "/ws?x=1", "/h2");
+  CHECK(ws.kind == RouteKind::kSessionSocket);
+  CHECK(ws.query == "x=1");
+  CHECK(route_request("GET", "/h2/admin/watch/" + kToken + "/ws", "/h2").kind == RouteKind::kWatchSocket);
+  CHECK(route_request("GET", "/h2/admin", "/h2").kind == RouteKind::kAdminPage);
+  CHECK(route_request("GET", "/h2/admin/admin.js", "/h2").file == "admin.js");
+  CHECK(route_request("GET", "/h2/api/sessions", "/h2").kind == RouteKind::kApiSessions);
+  CHECK(route_request("POST", "/h2/api/sessions/7/end", "/h2").session_id == 7);
+  CHECK(route_request("GET", "/h2/start?uid=a", "/h2").kind == RouteKind::kStart);
+  CHECK(route_request("GET", "/h2/start?uid=a", "/h2").query == "uid=a");
+  CHECK(route_request("GET", "/h2", "/h2").kind == RouteKind::kHome);
+  CHECK(route_request("GET", "/h2/", "/h2").kind == RouteKind::kHome);
+}
+
+TEST_CASE("the balancer's unprefixed paths still route under a prefix") {
+  CHECK(route_request("GET", "/start?uid=a", "/h2").kind == RouteKind::kStart);
+  CHECK(route_request("GET", "/healthz", "/h2").kind == RouteKind::kHealth);
+  CHECK(route_request("GET", "/s/" + kToken + "/", "/h2").kind == RouteKind::kSessionFile);
+}
+
+TEST_CASE("a prefix ends at a path segment and is stripped once") {
+  CHECK(route_request("GET", "/h2x/start", "/h2").kind == RouteKind::kNotFound);
+  CHECK(route_request("GET", "/h20/healthz", "/h2").kind == RouteKind::kNotFound);
+  CHECK(route_request("GET", "/h2/h2/start", "/h2").kind == RouteKind::kNotFound);
+  CHECK(route_request("GET", "/h1/start", "/h2").kind == RouteKind::kNotFound);  // another host's prefix
+  CHECK(rfbsim::manager::strip_path_prefix("/h2/a", "/h2") == "/a");
+  CHECK(rfbsim::manager::strip_path_prefix("/h2", "/h2") == "/");
+  CHECK(rfbsim::manager::strip_path_prefix("/h2a", "/h2") == "/h2a");
+  CHECK(rfbsim::manager::strip_path_prefix("/a", "") == "/a");
+}
+
+TEST_CASE("drain, undrain, host and cluster are admin API paths") {
+  CHECK(kind("POST", "/api/drain") == RouteKind::kApiDrain);
+  CHECK(kind("POST", "/api/undrain") == RouteKind::kApiUndrain);
+  CHECK(kind("GET", "/api/host") == RouteKind::kApiHost);
+  CHECK(kind("GET", "/api/cluster") == RouteKind::kApiCluster);
+  CHECK(route_request("POST", "/h3/api/drain", "/h3").kind == RouteKind::kApiDrain);
+  // Drain changes state: GET (a prefetch, a crawler following a link) must not do it.
+  CHECK(kind("GET", "/api/drain") == RouteKind::kBadMethod);
+  CHECK(std::string(route_request("GET", "/api/undrain").allowed) == "POST");
+  CHECK(kind("POST", "/api/host") == RouteKind::kBadMethod);
+  CHECK(kind("GET", "/api/drain/") == RouteKind::kNotFound);
+}
+
+TEST_CASE("a path prefix is a slash and 1 to 32 of a-z, 0-9 and -") {
+  using rfbsim::manager::is_path_prefix;
+  CHECK(is_path_prefix("/h2"));
+  CHECK(is_path_prefix("/a"));
+  CHECK(is_path_prefix("/" + std::string(32, 'z')));
+  CHECK(is_path_prefix("/host-0"));
+  CHECK_FALSE(is_path_prefix(""));
+  CHECK_FALSE(is_path_prefix("/"));
+  CHECK_FALSE(is_path_prefix("h2"));
+  CHECK_FALSE(is_path_prefix("/h2/"));
+  CHECK_FALSE(is_path_prefix("/H2"));
+  CHECK_FALSE(is_path_prefix("/h_2"));
+  CHECK_FALSE(is_path_prefix("/a/b"));
+  CHECK_FALSE(is_path_prefix("/" + std::string(33, 'z')));
+}

@@ -87,6 +87,7 @@ TEST_CASE("the admin API's session JSON names every field, and the token only wh
       R"({"id":7,"uid":"p-01","scenario":"lab","seed":"42","state":"running","detail":"said \"hi\"",)"
       R"("exit_status":"","created_at":"2026-11-24T10:00:00.000Z","ready_at":"2026-11-24T10:00:00.250Z",)"
       R"("ended_at":null,"data_path":"/data/sessions/7-p-01","outcome":null,)"
+      R"("copy_state":"","copy_attempts":0,"copy_error":"",)"
       R"("params":{"uid":"p-01","scenario":"lab","seed":"42"},"codec":null,"rtt_ms":null,"fps":null)";
   CHECK(rfbsim::manager::session_json(s, false) == expected + "}");
   CHECK(rfbsim::manager::session_json(s, true) == expected + R"(,"token":"0123456789abcdef0123456789abcdef"})");
@@ -117,10 +118,11 @@ TEST_CASE("the session record beside the data says how the session ended, with n
   session.token = "0123456789abcdef0123456789abcdef";
   session.state = rfbsim::manager::SessionState::kAbandoned;
   session.detail = "no browser connected for 60 s";
+  session.host_id = "h2";
   session.created = rfbsim::manager::WallTime{} + std::chrono::seconds(1'700'000'000);
   session.ended_at = session.created + std::chrono::seconds(61);
   CHECK(rfbsim::manager::session_record_json(session) ==
-        "{\"id\":7,\"uid\":\"p\\\"1\",\"state\":\"abandoned\",\"detail\":\"no browser connected for 60 s\","
+        "{\"id\":7,\"uid\":\"p\\\"1\",\"host\":\"h2\",\"state\":\"abandoned\",\"detail\":\"no browser connected for 60 s\","
         "\"created_at\":\"2023-11-14T22:13:20.000Z\",\"ready_at\":null,\"spent_at\":null,"
         "\"ended_at\":\"2023-11-14T22:14:21.000Z\",\"outcome\":null,\"data_incomplete\":null}\n");
   session.spent_at = session.created + std::chrono::milliseconds(1500);

@@ -1,0 +1,296 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// The uid registry with three real sim_manager processes on loopback (no balancer: the test follows the
+// redirects itself): a uid's first host keeps it, the others send its participant there, concurrent starts
+// on every host make one session, a killed or restarted home keeps its uids, two hosts down means "try again"
+// with nothing created, and a claim signed with another secret is refused.
+#include <catch2/catch.hpp>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <openssl/evp.h>
+#include <openssl/hmac.h>
+
+#include <atomic>
+#include <csignal>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <thread>
+
+#include "manager_process.hpp"
+#include "rfb_test_client.hpp"
+#include "ws_rfb_bridge.hpp"
+
+using namespace std::chrono_literals;
+using rfbsim::test::ManagerUnderTest;
+using rfbsim::test::TempDir;
+namespace net = rfbsim::test::net;
+
+namespace {
+
+const std::string kSecret = "registry-test-secret-0123456789";
+const std::string kAdminToken = "registry-admin-token-0123";
+
+// Lower-case hex HMAC-SHA256, written here again so that the test does not trust the manager's own.
+std::string hmac_hex(const std::string& secret, const std::string& text) {
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  HMAC(EVP_sha256(), secret.data(), static_cast<int>(secret.size()),
+       reinterpret_cast<const unsigned char*>(text.data()), text.size(), digest, &length);
+  std::string hex;
+  for (unsigned int i = 0; i < length; ++i) {
+    static const char* const kHex = "0123456789abcdef";
+    hex += kHex[digest[i] >> 4];
+    hex += kHex[digest[i] & 0xf];
+  }
+  return hex;
+}
+
+// A loopback port that was free a moment ago.
+int free_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  REQUIRE(::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
+  REQUIRE(::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0);
+  ::close(fd);
+  return ntohs(address.sin_port);
+}
+
+// Sends `text` to 127.0.0.1:`port` and returns everything read until the peer closes (or 5 s pass).
+std::string ask_registry(int port, const std::string& text) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  timeval timeout{5, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = htons(static_cast<std::uint16_t>(port));
+  std::string answer;
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0 &&
+      ::send(fd, text.data(), text.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(text.size())) {
+    char buffer[512];
+    ssize_t got = 0;
+    while ((got = ::recv(fd, buffer, sizeof buffer, 0)) > 0) answer.append(buffer, static_cast<std::size_t>(got));
+  }
+  ::close(fd);
+  return answer;
+}
+
+// Three hosts h1..h3 with their registries on fixed loopback ports, each in a data folder of its own.
+class Cluster {
+ public:
+  Cluster() {
+    secret_file_ = (secret_dir_.path() / "cluster.secret").string();
+    std::ofstream(secret_file_) << kSecret << "\n";
+    ::chmod(secret_file_.c_str(), 0600);
+    std::string peers;
+    for (int i = 0; i < 3; ++i) {
+      registry_ports_.push_back(free_port());
+      peers += (i == 0 ? "" : ",") + id(i) + "=127.0.0.1:" + std::to_string(registry_ports_.back());
+    }
+    peers_ = peers;
+    for (int i = 0; i < 3; ++i) {
+      data_.push_back(std::make_unique<TempDir>("rfbsim-registry-test"));
+      hosts_.emplace_back();
+      start(i);
+    }
+  }
+
+  static std::string id(int i) { return "h" + std::to_string(i + 1); }
+  ManagerUnderTest& host(int i) { return *hosts_.at(static_cast<std::size_t>(i)); }
+  [[nodiscard]] int registry_port(int i) const { return registry_ports_.at(static_cast<std::size_t>(i)); }
+
+  // (Re)starts host i on its data folder.
+  void start(int i) {
+    const auto index = static_cast<std::size_t>(i);
+    hosts_[index].reset();
+    hosts_[index] = std::make_unique<ManagerUnderTest>(
+        data_[index]->path(),
+        rfbsim::test::without_abuse_limits(
+            {"--host-id", id(i), "--cluster-peers", peers_, "--cluster-secret-file", secret_file_,
+             "--session-kind", "rfb", "--session-command", RFBSIM_MINIMAL, "--session-arg", "{port}",
+             "--scenarios", "demo", "--max-sessions", "8", "--admin-token", kAdminToken}));
+  }
+
+  // kill -9: its sessions die with it (PR_SET_PDEATHSIG).
+  void kill(int i) { host(i).process().stop(SIGKILL, 5s); }
+
+  // The rows of `uid` in all three indexes, as (host index, row).
+  std::vector<std::pair<int, rfbsim::test::IndexRow>> rows_of(const std::string& uid) {
+    std::vector<std::pair<int, rfbsim::test::IndexRow>> out;
+    for (int i = 0; i < 3; ++i) {
+      for (const auto& row : host(i).index_rows()) {
+        if (row.uid == uid) out.emplace_back(i, row);
+      }
+    }
+    return out;
+  }
+
+  // GET of a Location the balancer would route by its /hN prefix.
+  net::HttpResponse follow(const net::HttpResponse& redirect) {
+    const std::string& location = redirect.headers.at("location");
+    REQUIRE(location.size() > 4);
+    REQUIRE(location.rfind("/h", 0) == 0);
+    const int i = location[2] - '1';
+    return host(i).get(location);
+  }
+
+ private:
+  TempDir secret_dir_{"rfbsim-registry-secret"};
+  std::string secret_file_;
+  std::string peers_;
+  std::vector<int> registry_ports_;
+  std::vector<std::unique_ptr<TempDir>> data_;
+  std::vector<std::unique_ptr<ManagerUnderTest>> hosts_;
+};
+
+// The token in a 302 to /hN/s/<token>/ ("" for anything else).
+std::string token_of(const net::HttpResponse& response, const std::string& host_id) {
+  if (response.status != 302) return "";
+  const std::string& location = response.headers.at("location");
+  const std::string prefix = "/" + host_id + "/s/";
+  if (location.rfind(prefix, 0) != 0 || location.size() != prefix.size() + 33) return "";
+  return location.substr(prefix.size(), 32);
+}
+
+}  // namespace
+
+TEST_CASE("a uid's first host keeps it; the other hosts send its participant there", "[manager][registry]") {
+  Cluster cluster;
+  const auto first = cluster.host(1).start("uid=reg-x&scenario=demo");
+  const std::string token = token_of(first, "h2");
+  REQUIRE(token.size() == 32);
+
+  for (const int other : {0, 2}) {
+    const auto moved = cluster.host(other).start("uid=reg-x&scenario=demo");
+    REQUIRE(moved.status == 303);
+    CHECK(moved.headers.at("location") == "/h2/start?uid=reg-x&scenario=demo");
+    // Following it reaches the same session.
+    CHECK(token_of(cluster.follow(moved), "h2") == token);
+  }
+  const auto rows = cluster.rows_of("reg-x");
+  REQUIRE(rows.size() == 1);
+  CHECK(rows.front().first == 1);
+}
+
+TEST_CASE("concurrent starts of one uid on every host make exactly one session", "[manager][registry]") {
+  Cluster cluster;
+  for (int round = 0; round < 6; ++round) {
+    const std::string uid = "reg-race-" + std::to_string(round);
+    std::atomic<int> ready{0};
+    std::vector<net::HttpResponse> responses(3);
+    std::vector<std::thread> threads;
+    for (int i = 0; i < 3; ++i) {
+      threads.emplace_back([&, i] {
+        ++ready;
+        while (ready.load() < 3) std::this_thread::yield();
+        responses[static_cast<std::size_t>(i)] = cluster.host(i).start("uid=" + uid + "&scenario=demo");
+      });
+    }
+    for (auto& thread : threads) thread.join();
+    const auto rows = cluster.rows_of(uid);
+    CAPTURE(uid);
+    REQUIRE(rows.size() == 1);
+    const std::string home = Cluster::id(rows.front().first);
+    for (int i = 0; i < 3; ++i) {
+      const auto& response = responses[static_cast<std::size_t>(i)];
+      CAPTURE(i, response.status);
+      if (Cluster::id(i) == home) {
+        CHECK(token_of(response, home) == rows.front().second.token);
+      } else {
+        // Another host either redirected to the home, or (too few answers at that moment) asked for a retry.
+        const bool redirected =
+            response.status == 303 && response.headers.at("location").rfind("/" + home + "/", 0) == 0;
+        CHECK((redirected || response.status == 503));
+      }
+    }
+  }
+}
+
+TEST_CASE("a killed home keeps its uids, and after its restart a completed uid is completed everywhere",
+          "[manager][registry]") {
+  Cluster cluster;
+  // A live session on h2, and one that is completed: a participant saw it, then it was ended.
+  const std::string live = token_of(cluster.host(1).start("uid=reg-live&scenario=demo"), "h2");
+  const std::string done = token_of(cluster.host(1).start("uid=reg-done&scenario=demo"), "h2");
+  REQUIRE(live.size() == 32);
+  REQUIRE(done.size() == 32);
+  REQUIRE(cluster.host(1).wait_for_state(done, "running"));
+  {
+    const std::string url = "ws://127.0.0.1:" + std::to_string(cluster.host(1).port()) + "/h2/s/" + done + "/ws";
+    rfbsim::test::WsRfbBridge bridge(url);
+    rfbsim::test::RfbTestClient client("127.0.0.1", bridge.port());
+    REQUIRE(client.wait_for_updates(1, 20s));
+    REQUIRE(client.pump_until(
+        [&] {
+          const auto spent = cluster.host(1).row_for_token(done);
+          return spent && !spent->spent_at.empty();
+        },
+        20s));
+    const auto row = cluster.host(1).row_for_token(done);
+    REQUIRE(row);
+    REQUIRE(cluster.host(1).end_session(row->id, kAdminToken).status == 200);
+    REQUIRE(cluster.host(1).wait_for_state(done, "ended"));
+  }
+
+  cluster.kill(1);
+  for (const char* uid : {"reg-live", "reg-done"}) {
+    for (const int other : {0, 2}) {
+      const auto moved = cluster.host(other).start(std::string("uid=") + uid + "&scenario=demo");
+      CAPTURE(uid, other);
+      CHECK(moved.status == 303);
+      CHECK(moved.headers.at("location").rfind("/h2/start?", 0) == 0);
+    }
+    CHECK(cluster.rows_of(uid).size() == 1);  // nothing new on h1 or h3
+  }
+
+  cluster.start(1);  // same data folder, same registry port
+  for (int i = 0; i < 3; ++i) {
+    auto response = cluster.host(i).start("uid=reg-done&scenario=demo");
+    if (response.status == 303) response = cluster.follow(response);
+    CAPTURE(i);
+    CHECK(response.status == 409);
+  }
+  for (const auto& [host, r] : cluster.rows_of("reg-live")) CHECK(host == 1);
+}
+
+TEST_CASE("with two of three hosts down a new uid is asked to retry and nothing starts", "[manager][registry]") {
+  Cluster cluster;
+  cluster.kill(1);
+  cluster.kill(2);
+  const auto response = cluster.host(0).start("uid=reg-alone&scenario=demo");
+  CHECK(response.status == 503);
+  CHECK(response.headers.at("retry-after") == "5");
+  CHECK(response.body.find("try again") != std::string::npos);
+  CHECK(cluster.host(0).index_rows().empty());
+}
+
+TEST_CASE("the registry port refuses forged, stale, malformed and overlong claims", "[manager][registry]") {
+  Cluster cluster;
+  const int port = cluster.registry_port(0);
+  const long long now = std::chrono::duration_cast<std::chrono::seconds>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                            .count();
+  auto line = [](const std::string& secret, const std::string& uid, const std::string& host, long long time) {
+    const std::string text = "claim " + uid + " " + host + " " + std::to_string(time);
+    return text + " " + hmac_hex(secret, text) + "\n";
+  };
+  CHECK(ask_registry(port, line("a-forged-secret-0123456789", "reg-forged", "h3", now)) == "error bad hmac\n");
+  CHECK(ask_registry(port, line(kSecret, "reg-forged", "h3", now - 600)) == "error stale time\n");
+  CHECK(ask_registry(port, "hello\n").rfind("error ", 0) == 0);
+  CHECK(ask_registry(port, std::string(300, 'x') + "\n") == "error line too long\n");
+  // The forged claim recorded nothing: the uid's first real claim decides.
+  CHECK(ask_registry(port, line(kSecret, "reg-forged", "h2", now)) ==
+        "owner h2 " + hmac_hex(kSecret, "owner reg-forged h2") + "\n");
+  CHECK(ask_registry(port, line(kSecret, "reg-forged", "h3", now)) ==
+        "owner h2 " + hmac_hex(kSecret, "owner reg-forged h2") + "\n");
+  // The manager carries on.
+  CHECK(cluster.host(0).get("/healthz").status == 200);
+}
