@@ -36,11 +36,20 @@ const std::string* value_of(std::string_view name, const CopyPlaceholders& value
 std::string copy_command_problem(const std::vector<std::string>& command) {
   if (command.empty()) return "";
   if (command.front().empty()) return "after_session_command: the program (its first item) is empty";
-  for (const std::string& arg : command) {
+  for (std::size_t item = 0; item < command.size(); ++item) {
+    const std::string& arg = command[item];
     for (std::size_t i = 0; i < arg.size(); ++i) {
       const std::size_t length = placeholder_length(arg, i);
       if (length == 0) continue;
       const std::string_view name = std::string_view(arg).substr(i + 1, length - 2);
+      // A value at the start of an argument could read as an option: uids may begin with '-' ("-etouch" to
+      // rsync names a remote shell). {folder} is an absolute path, so it always begins with '/'.
+      if (i == 0 && (item == 0 || name != "folder")) {
+        return "after_session_command: '" + arg + "' begins with {" + std::string(name) + "}" +
+               (item == 0 ? ", but the program must be fixed"
+                          : ": a value such as a uid beginning with '-' would read as an option; put a fixed "
+                            "prefix before it (e.g. 'store:/study/{" + std::string(name) + "}')");
+      }
       if (std::find(kCopyPlaceholders.begin(), kCopyPlaceholders.end(), name) == kCopyPlaceholders.end()) {
         std::string known;
         for (const std::string_view k : kCopyPlaceholders) known += (known.empty() ? "{" : " {") + std::string(k) + "}";

@@ -86,3 +86,12 @@ TEST_CASE("after_session_command is one flag per argument, commas included, and 
   CHECK(parse_manager_args({"--after-session-timeout-s", "0"}).error ==
         "--after-session-timeout-s '0': expected whole seconds 1..604800");
 }
+
+TEST_CASE("a placeholder other than {folder} may not begin an argument, nor any the program") {
+  // A uid may begin with '-': as an argument of its own it would be an option ("-etouch" to rsync).
+  CHECK(copy_command_problem({"rsync", "-a", "{folder}/", "{uid}"}).find("begins with {uid}") != std::string::npos);
+  CHECK(copy_command_problem({"cp", "-r", "{folder}", "{host}/{folder_name}"}).find("begins with {host}") !=
+        std::string::npos);
+  CHECK(copy_command_problem({"{folder}/copy.sh"}).find("the program must be fixed") != std::string::npos);
+  CHECK(copy_command_problem({"rsync", "-a", "{folder}/", "/store/{host}/{uid}"}) == "");
+}
