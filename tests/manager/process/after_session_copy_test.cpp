@@ -204,7 +204,7 @@ TEST_CASE("a copy that always fails ends failed with its words recorded, and the
   // Slow to fail, so that a session's process exits (and is reaped) while a copy runs.
   const std::string script =
       write_script(store.path() / "broken-copy.sh", "sleep 2\necho \"store unreachable: $1\" >&2\nexit 3\n");
-  ManagerUnderTest manager(data.path(), copy_flags({script, "{session_id}"}, {"--after-session-retries", "1"}));
+  ManagerUnderTest manager(data.path(), copy_flags({script, "session={session_id}"}, {"--after-session-retries", "1"}));
   const std::string first = start_failing_session(manager, "broken-1");
   const std::string second = start_failing_session(manager, "broken-2");
 
@@ -218,7 +218,7 @@ TEST_CASE("a copy that always fails ends failed with its words recorded, and the
     const CopyColumns copy = wait_for_copy(data.path(), row.token, "failed", 60s);
     CHECK(copy.state == "failed");
     CHECK(copy.attempts == 2);
-    CHECK(copy.error == "exit 3: store unreachable: " + std::to_string(row.id));
+    CHECK(copy.error == "exit 3: store unreachable: session=" + std::to_string(row.id));
   }
   CHECK(manager.get("/healthz").status == 200);
   const std::string next = token_from_redirect(manager.start("uid=after-broken&scenario=lab"));
