@@ -42,6 +42,12 @@ std::string copy_command_problem(const std::vector<std::string>& command) {
       const std::size_t length = placeholder_length(arg, i);
       if (length == 0) continue;
       const std::string_view name = std::string_view(arg).substr(i + 1, length - 2);
+      if (std::find(kCopyPlaceholders.begin(), kCopyPlaceholders.end(), name) == kCopyPlaceholders.end()) {
+        std::string known;
+        for (const std::string_view k : kCopyPlaceholders) known += (known.empty() ? "{" : " {") + std::string(k) + "}";
+        return "after_session_command: unknown placeholder {" + std::string(name) + "} in '" + arg + "' (known: " +
+               known + ")";
+      }
       // A value at the start of an argument could read as an option: uids may begin with '-' ("-etouch" to
       // rsync names a remote shell). {folder} is an absolute path, so it always begins with '/'.
       if (i == 0 && (item == 0 || name != "folder")) {
@@ -49,12 +55,6 @@ std::string copy_command_problem(const std::vector<std::string>& command) {
                (item == 0 ? ", but the program must be fixed"
                           : ": a value such as a uid beginning with '-' would read as an option; put a fixed "
                             "prefix before it (e.g. 'store:/study/{" + std::string(name) + "}')");
-      }
-      if (std::find(kCopyPlaceholders.begin(), kCopyPlaceholders.end(), name) == kCopyPlaceholders.end()) {
-        std::string known;
-        for (const std::string_view k : kCopyPlaceholders) known += (known.empty() ? "{" : " {") + std::string(k) + "}";
-        return "after_session_command: unknown placeholder {" + std::string(name) + "} in '" + arg + "' (known: " +
-               known + ")";
       }
       i += length - 1;
     }
