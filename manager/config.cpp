@@ -120,6 +120,14 @@ bool is_origin(const std::string& origin) {
   return true;
 }
 
+// A host name as DNS compares it: ASCII letters without case.
+std::string lower_case(std::string text) {
+  for (char& ch : text) {
+    if (ch >= 'A' && ch <= 'Z') ch = static_cast<char>(ch - 'A' + 'a');
+  }
+  return text;
+}
+
 // "ID=ADDRESS:PORT", one entry of cluster_peers.
 std::optional<ClusterPeer> parse_cluster_peer(const std::string& entry) {
   const std::size_t eq = entry.find('=');
@@ -288,6 +296,11 @@ const std::map<std::string, Setting>& settings() {
            if (!peer) return "'" + entry + "' is not ID=ADDRESS:PORT (ID: 1-32 of a-z 0-9 -, PORT: 1..65535)";
            for (const ClusterPeer& other : peers) {
              if (other.id == peer->id) return "host id '" + peer->id + "' is listed twice";
+             // Two ids at one registry would be one acceptor voting twice: majorities would no longer intersect.
+             if (other.port == peer->port && lower_case(other.address) == lower_case(peer->address)) {
+               return "hosts '" + other.id + "' and '" + peer->id + "' have the same registry " + peer->address + ":" +
+                      std::to_string(peer->port);
+             }
            }
            peers.push_back(*peer);
          }
@@ -404,7 +417,8 @@ std::string manager_usage() {
          "                          this host (repeat; no shell; {folder} {folder_name} {uid} {host} {session_id})\n"
          "  --after-session-retries N (default 5), --after-session-timeout-s S (default 600)   its tries\n"
          "  --cluster-peers ID=ADDR:PORT,...   every host's uid registry, this one included (several hosts:\n"
-         "                          a uid gets one session in the whole cluster; needs --host-id)\n"
+         "                          a uid gets one session in the whole cluster; needs --host-id; the same\n"
+         "                          entries on every host, an odd number of them)\n"
          "  --cluster-secret-file F the hosts' shared registry secret, 16+ bytes (mode 0600)\n"
          "  --registry-port N       this host's registry port (default: its cluster-peers entry's)\n"
          "  --registry-bind ADDR    the registry's numeric IPv4 address (default: listen-address)\n"

@@ -376,7 +376,15 @@ class FrontendImpl final : public Frontend, public SessionListener {
       return;
     }
     // Several hosts: a uid this host has no session of starts only where the uid registry decides its home.
-    if (registry_ != nullptr && needs_claim(parsed.request->uid)) {
+    const Claim claim = registry_ != nullptr ? needs_claim(parsed.request->uid) : Claim::kNo;
+    if (claim == Claim::kUnknown) {
+      // Whether the uid has a session here is unknown: starting one unclaimed could make a second home.
+      metrics_.count_rejection(Rejection::kBusy);
+      respond_page(con, 503, retry_later_page(kUndecidedRetrySeconds),
+                   {{"Retry-After", std::to_string(kUndecidedRetrySeconds)}});
+      return;
+    }
+    if (claim == Claim::kYes) {
       con->defer_http_response();
       registry_->claim(parsed.request->uid, [this, con, request = *parsed.request, address,
                                              query = route.query](const std::optional<std::string>& home) {
@@ -404,16 +412,24 @@ class FrontendImpl final : public Frontend, public SessionListener {
     start_session(con, *parsed.request, address, false);
   }
 
-  // Whether /start of `uid` must ask the uid registry first: this host has no session of it, and could
-  // start one. A full or draining host claims nothing (its busy page sends the participant elsewhere, and
-  // nothing was recorded); an index that cannot be read is left to the supervisor, which says so.
-  bool needs_claim(const std::string& uid) {
+  // Whether /start of `uid` must ask the uid registry first.
+  enum class Claim {
+    kNo,       // this host has a session of the uid, or could not start one anyway
+    kYes,      // a uid new here, and a free slot: the registry decides where it starts
+    kUnknown,  // the index could not be read: the participant retries in a moment
+  };
+  // A full or draining host claims nothing (its busy page sends the participant elsewhere, and nothing was
+  // recorded).
+  Claim needs_claim(const std::string& uid) {
     try {
-      if (supervisor_.has_session_for_uid(uid)) return false;
-    } catch (const std::exception&) {
-      return false;
+      if (supervisor_.has_session_for_uid(uid)) return Claim::kNo;
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "[manager] /start of uid %s: cannot read the index (%s); asked to retry\n", uid.c_str(),
+                   error.what());
+      return Claim::kUnknown;
     }
-    return !supervisor_.table().full() && !supervisor_.draining() && !supervisor_.shutting_down();
+    const bool can_start = !supervisor_.table().full() && !supervisor_.draining() && !supervisor_.shutting_down();
+    return can_start ? Claim::kYes : Claim::kNo;
   }
 
   // Admits `request` on this host; `deferred`: the response was deferred already (after a claim round).

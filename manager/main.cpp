@@ -26,6 +26,7 @@
 #include "session_index.hpp"
 #include "start_request.hpp"
 #include "supervisor.hpp"
+#include "uid_registry.hpp"
 
 extern char** environ;
 
@@ -159,7 +160,7 @@ int run(ManagerConfig config) {
   }
   // Before the first link: the index says what happened to the previous run's sessions.
   supervisor.flush_index();
-  // Several hosts: this host's acceptor of the uid registry, and its claimer, which /start asks before it
+  // Several hosts: this host's acceptor of the uid registry, and its proposer, which /start asks before it
   // starts a session of a uid new here (docs/architecture.md, "uid registry").
   std::unique_ptr<manager::RegistryServer> registry_server;
   std::unique_ptr<manager::RegistryClient> registry_client;
@@ -168,12 +169,31 @@ int run(ManagerConfig config) {
     const auto self = std::find_if(config.cluster_peers.begin(), config.cluster_peers.end(),
                                    [&](const manager::ClusterPeer& peer) { return peer.id == config.host_id; });
     const std::string registry_address = config.registry_bind.empty() ? config.listen_address : config.registry_bind;
+    // The key binds the peer list too: hosts started on different lists cannot count each other's votes.
+    const std::string key = manager::registry_key(secret, config.cluster_peers);
     registry_server = std::make_unique<manager::RegistryServer>(
-        io, registry_address, self->port, secret, (std::filesystem::path(config.data_dir) / "sessions.db").string());
-    registry_client = std::make_unique<manager::RegistryClient>(io, config.cluster_peers, config.host_id, secret,
-                                                                *registry_server);
+        io, registry_address, self->port, key, config.host_id, config.cluster_peers,
+        (std::filesystem::path(config.data_dir) / "sessions.db").string());
+    registry_client =
+        std::make_unique<manager::RegistryClient>(io, config.cluster_peers, config.host_id, key, *registry_server);
     std::fprintf(stderr, "[manager] uid registry on %s:%d, host %s of %zu\n", registry_address.c_str(),
                  registry_server->port(), config.host_id.c_str(), config.cluster_peers.size());
+    if (config.cluster_peers.size() % 2 == 0) {
+      std::fprintf(stderr,
+                   "[manager] warning: %zu cluster peers: a majority is %zu of them, so %zu down stop every new uid, "
+                   "as with %zu peers; an odd number is better (docs/architecture.md, \"uid registry\")\n",
+                   config.cluster_peers.size(), config.cluster_peers.size() / 2 + 1, config.cluster_peers.size() / 2,
+                   config.cluster_peers.size() - 1);
+    }
+    // An acceptor that forgot what it promised or accepted can let a second home be decided: a host rebuilt
+    // with an empty data folder must join under a new id (docs/architecture.md, "uid registry").
+    if (index.registry_table_created()) {
+      std::fprintf(stderr,
+                   "[manager] WARNING: this host's uid registry records are new (sessions.db or its uid_acceptors "
+                   "table was just created). Fine on a cluster's first start. If this host ran before and lost its "
+                   "sessions.db, stop it: it must rejoin under a new host_id, with every host restarted on the new "
+                   "cluster_peers list (docs/architecture.md, \"uid registry\")\n");
+    }
   }
   const auto frontend = manager::make_frontend(io, config, supervisor, metrics, web_root, registry_client.get());
   // HAProxy's agent-check: asked on every check, so its line always says the load of that moment. It stays up

@@ -1,59 +1,75 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// RegistryClient: the claimer's side of the uid registry (manager/uid_registry.hpp). A claim round asks the
-// peers one at a time, in the uid's rendezvous order, each with a timeout of its own; this host's acceptor is
-// asked in-process at its place in the order. Asynchronous on the manager's I/O thread: nothing blocks, and
-// the result comes back on that thread.
+// RegistryClient: the proposer's side of the uid registry (manager/uid_registry.hpp). A claim runs Paxos for
+// the uid: phase 1 (prepare) and phase 2 (accept) each go to every peer at once, with one timeout per phase;
+// this host's acceptor is asked in-process. A ballot that is refused or gets too few answers is retried with
+// a higher one after a short random pause, a few times, then the claim is undecided. Asynchronous on the
+// manager's I/O thread: nothing blocks (peer names are resolved in the background, never during a claim),
+// and the result comes back on that thread.
 #pragma once
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "config.hpp"
 #include "registry_server.hpp"
+#include "uid_registry.hpp"
 
 namespace rfbsim::manager {
 
 class RegistryClient {
  public:
-  /// The uid's decided home, or nothing when too few peers answered to decide (retry later).
+  /// The uid's decided home, or nothing when no ballot reached a majority (retry later).
   using Decided = std::function<void(const std::optional<std::string>& home)>;
 
-  /// Claims for `self` among `peers` (this host included), signing with `secret`; `own` is this host's
-  /// acceptor, which must outlive this object. `peer_timeout`: how long one peer may take to answer.
-  RegistryClient(boost::asio::io_context& io, std::vector<ClusterPeer> peers, std::string self, std::string secret,
-                 RegistryServer& own, std::chrono::milliseconds peer_timeout = std::chrono::seconds(1));
+  /// Proposes for `self` among `peers` (this host included), signing with `key` (registry_key); `own` is
+  /// this host's acceptor, which must outlive this object. `phase_timeout`: how long one phase waits for
+  /// answers. Starts resolving the peers' names at once, in the background.
+  RegistryClient(boost::asio::io_context& io, std::vector<ClusterPeer> peers, std::string self, std::string key,
+                 RegistryServer& own, std::chrono::milliseconds phase_timeout = std::chrono::seconds(1));
   ~RegistryClient();
   RegistryClient(const RegistryClient&) = delete;
   RegistryClient& operator=(const RegistryClient&) = delete;
 
-  /// Runs a claim round for `uid` proposing this host; `done` is called once, on the I/O thread.
+  /// Decides `uid`'s home (this host unless a value was accepted before); `done` is called once, on the I/O
+  /// thread.
   void claim(const std::string& uid, Decided done);
   /// This host's id.
   [[nodiscard]] const std::string& self() const { return self_; }
 
  private:
-  struct Round;
-  void ask_next(const std::shared_ptr<Round>& round);
-  // A remote peer's exchange, step by step: resolve (ask_peer), connect and send, read the owner line.
-  void ask_peer(const std::shared_ptr<Round>& round, const ClusterPeer& peer);
-  void send_claim(const std::shared_ptr<Round>& round,
-                  const boost::asio::ip::tcp::resolver::results_type& endpoints);
-  void read_answer(const std::shared_ptr<Round>& round);
-  // The peer of the round's current attempt answered `home` (nothing: it did not, or not validly).
-  void peer_done(const std::shared_ptr<Round>& round, const std::optional<std::string>& home);
+  struct Remote;    // a peer's address and what its name resolved to
+  struct Round;     // one claim: up to kAttempts ballots
+  struct Phase;     // one phase of one ballot: a request to every peer, answers until the outcome is known
+  struct Exchange;  // one peer's connection in a phase
+  void resolve(const std::shared_ptr<Remote>& remote);
+  void run_ballot(const std::shared_ptr<Round>& round);
+  void run_phase(const std::shared_ptr<Round>& round, MessageKind kind);
+  void ask(const std::shared_ptr<Phase>& phase, const std::shared_ptr<Remote>& remote);
+  // An acceptor's answer (nothing: none, or one that did not verify) reaches the phase's tally.
+  void answered(const std::shared_ptr<Phase>& phase, const std::string& acceptor,
+                const std::optional<RegistryMessage>& answer);
+  void settle(const std::shared_ptr<Phase>& phase);
+  void retry_or_give_up(const std::shared_ptr<Round>& round);
 
   boost::asio::io_context& io_;
   std::vector<ClusterPeer> peers_;
+  std::vector<std::string> ids_;
+  std::vector<std::shared_ptr<Remote>> remotes_;  // every peer but this host
   std::string self_;
-  std::string secret_;
+  std::string key_;
   RegistryServer& own_;
-  std::chrono::milliseconds peer_timeout_;
+  std::chrono::milliseconds phase_timeout_;
+  std::uint64_t counter_ = 0;  // the last ballot counter used or seen: the next ballot goes above it
+  std::mt19937 random_{std::random_device{}()};
 };
 
 }  // namespace rfbsim::manager

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The uid registry's acceptor: one signed line in, one signed line out, the record committed in between.
+// The uid registry's acceptor: one signed line in, one signed line out, the state committed in between.
 #include "registry_server.hpp"
 
 #include <sys/stat.h>
@@ -25,8 +25,11 @@ using asio::ip::tcp;
 
 // A peer sends its one line at once: a connection still silent after this is dropped.
 constexpr auto kReadTimeout = std::chrono::seconds(2);
-// Connections served at once; more are closed at accept (a claimer treats that as a peer that is down).
+// Connections served at once; more are closed at accept (a proposer treats that as a peer that is down).
 constexpr int kMaxConnections = 64;
+// After a failed accept (EMFILE), wait this long before the next: accepting at once would spin on the I/O
+// thread (the same pause as agent_check.cpp's).
+constexpr auto kAcceptPause = std::chrono::milliseconds(100);
 
 long long unix_now() {
   return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -49,9 +52,15 @@ struct RegistryServer::Connection {
   std::shared_ptr<int> open_count;
 };
 
-RegistryServer::RegistryServer(asio::io_context& io, const std::string& bind_address, int port, std::string secret,
-                               const std::string& index_path)
-    : io_(io), secret_(std::move(secret)), store_(index_path), acceptor_(io) {
+RegistryServer::RegistryServer(asio::io_context& io, const std::string& bind_address, int port, std::string key,
+                               std::string self, std::vector<ClusterPeer> peers, const std::string& index_path)
+    : io_(io),
+      key_(std::move(key)),
+      self_(std::move(self)),
+      peers_(std::move(peers)),
+      store_(index_path),
+      acceptor_(io),
+      accept_pause_(io) {
   boost::system::error_code ec;
   const auto address = asio::ip::make_address_v4(bind_address, ec);
   if (ec) throw std::runtime_error("registry: '" + bind_address + "' is not a numeric IPv4 address");
@@ -65,6 +74,7 @@ RegistryServer::RegistryServer(asio::io_context& io, const std::string& bind_add
                              ec.message());
   }
   port_ = acceptor_.local_endpoint().port();
+  initial_counter_ = store_.max_uid_ballot_counter();  // before the pool's thread uses store_
   accept();
 }
 
@@ -76,24 +86,38 @@ RegistryServer::~RegistryServer() {
 void RegistryServer::stop() {
   boost::system::error_code ignored;
   acceptor_.close(ignored);
+  accept_pause_.cancel();
 }
 
-void RegistryServer::record(const std::string& uid, const std::string& host, Recorded done) {
-  asio::post(pool_, [this, uid, host, done = std::move(done)]() mutable {
-    std::string home;
+void RegistryServer::handle(const RegistryMessage& request, Answered done) {
+  asio::post(pool_, [this, request, done = std::move(done)]() mutable {
+    std::optional<RegistryMessage> answer;
     try {
-      home = store_.claim_uid_home(uid, host, std::chrono::system_clock::now());
+      // One thread owns this table (pool_), so read, rule and write need no lock of their own.
+      AcceptorState state = store_.uid_acceptor(request.uid);
+      const AcceptorState before = state;
+      RegistryMessage reply = acceptor_answer(state, request);
+      if (state != before) store_.set_uid_acceptor(request.uid, state, std::chrono::system_clock::now());
+      answer = std::move(reply);
     } catch (const std::exception& error) {
-      std::fprintf(stderr, "[registry] cannot record the home of uid %s: %s\n", uid.c_str(), error.what());
+      std::fprintf(stderr, "[registry] cannot keep the acceptor state of uid %s: %s\n", request.uid.c_str(),
+                   error.what());
     }
-    asio::post(io_, [done = std::move(done), home] { done(home); });
+    asio::post(io_, [done = std::move(done), answer = std::move(answer)] { done(answer); });
   });
 }
 
 void RegistryServer::accept() {
   acceptor_.async_accept([this](const boost::system::error_code& ec, tcp::socket socket) {
     if (ec == asio::error::operation_aborted || !acceptor_.is_open()) return;
-    if (!ec) serve(std::move(socket));
+    if (ec) {
+      accept_pause_.expires_after(kAcceptPause);
+      accept_pause_.async_wait([this](const boost::system::error_code& wait_ec) {
+        if (!wait_ec && acceptor_.is_open()) accept();
+      });
+      return;
+    }
+    serve(std::move(socket));
     accept();
   });
 }
@@ -122,15 +146,18 @@ void RegistryServer::serve(tcp::socket socket) {
         if (ec) return;  // closed or timed out: nothing to answer
         const auto data = connection->buffer.data();
         const std::string line(asio::buffers_begin(data), asio::buffers_begin(data) + static_cast<long>(length) - 1);
-        const ClaimParse parsed = parse_claim_line(line, secret_, unix_now());
-        if (!parsed.claim) {
-          std::fprintf(stderr, "[registry] refused a claim: %s\n", parsed.error.c_str());
-          answer(connection, error_line(parsed.error));
+        const MessageParse parsed = parse_message(line, key_);
+        const std::string problem =
+            parsed.message ? request_problem(*parsed.message, self_, peers_, unix_now()) : parsed.error;
+        if (!problem.empty()) {
+          // A bad hmac from a real peer means another secret or another cluster_peers list on that host.
+          std::fprintf(stderr, "[registry] refused a request: %s%s\n", problem.c_str(),
+                       problem == "bad hmac" ? " (another cluster_secret_file or cluster_peers list?)" : "");
+          answer(connection, error_line(problem));
           return;
         }
-        const std::string uid = parsed.claim->uid;
-        record(uid, parsed.claim->host, [this, connection, uid](const std::string& home) {
-          answer(connection, home.empty() ? error_line("index unavailable") : owner_line(secret_, uid, home));
+        handle(*parsed.message, [this, connection](const std::optional<RegistryMessage>& reply) {
+          answer(connection, reply ? format_message(key_, *reply) : error_line("index unavailable"));
         });
       });
 }

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// RegistryServer: this host's acceptor of the uid registry (manager/uid_registry.hpp), on a port of its own.
+// RegistryServer: this host's Paxos acceptor of the uid registry (manager/uid_registry.hpp), on a port of its own.
 //
-// Each connection carries one signed claim line and gets one answer: the home this host records for the uid,
-// the claimed one if it had none. The record is committed to the index (table uid_homes) before the answer
-// leaves, so that a crash can never make this host answer two different homes for one uid. The SQLite
+// Each connection carries one signed request line (prepare or accept) and gets one signed answer (promise,
+// accepted or reject). The acceptor's new state is committed to the index (table uid_acceptors) before the
+// answer leaves, so that a crash can never make this host break a promise or forget a value. The SQLite
 // writes run on a thread of their own with their own connection (a commit with synchronous=FULL waits for the
 // disk, and the I/O thread carries every relay); the sockets, their timeouts and every callback run on the
 // manager's I/O thread.
@@ -11,24 +11,30 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/thread_pool.hpp>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
+#include "config.hpp"
 #include "session_index.hpp"
+#include "uid_registry.hpp"
 
 namespace rfbsim::manager {
 
 class RegistryServer {
  public:
-  /// The home recorded for a uid, "" when the index could not record it. Called on the I/O thread.
-  using Recorded = std::function<void(const std::string& home)>;
+  /// The acceptor's answer, nothing when the index could not record its state. Called on the I/O thread.
+  using Answered = std::function<void(const std::optional<RegistryMessage>& answer)>;
 
-  /// Listens on `bind_address`:`port` (0: any free port) and records homes in the index at `index_path`
-  /// through its own connection. Throws std::runtime_error naming the cause (address in use, index).
-  RegistryServer(boost::asio::io_context& io, const std::string& bind_address, int port, std::string secret,
-                 const std::string& index_path);
+  /// Acceptor `self` among `peers`: listens on `bind_address`:`port` (0: any free port), verifies lines with
+  /// `key` (registry_key) and keeps its state in the index at `index_path` through its own connection.
+  /// Throws std::runtime_error naming the cause (address in use, index).
+  RegistryServer(boost::asio::io_context& io, const std::string& bind_address, int port, std::string key,
+                 std::string self, std::vector<ClusterPeer> peers, const std::string& index_path);
   /// Writes what is queued, then closes.
   ~RegistryServer();
   RegistryServer(const RegistryServer&) = delete;
@@ -36,9 +42,11 @@ class RegistryServer {
 
   /// The port bound.
   [[nodiscard]] int port() const { return port_; }
-  /// Records `host` as `uid`'s home unless it has one (this host's own claims come here without a socket);
-  /// `done` gets the home recorded, once it is committed.
-  void record(const std::string& uid, const std::string& host, Recorded done);
+  /// The highest ballot counter this acceptor had promised when it started (0: none).
+  [[nodiscard]] std::uint64_t initial_counter() const { return initial_counter_; }
+  /// Answers `request` (a prepare or accept addressed to this acceptor; this host's own proposals come here
+  /// without a socket); `done` gets the answer once the state it depends on is committed.
+  void handle(const RegistryMessage& request, Answered done);
   /// Stops accepting; connections in progress end by themselves within the read timeout.
   void stop();
 
@@ -49,10 +57,14 @@ class RegistryServer {
   void answer(const std::shared_ptr<Connection>& connection, std::string line);
 
   boost::asio::io_context& io_;
-  std::string secret_;
+  std::string key_;
+  std::string self_;
+  std::vector<ClusterPeer> peers_;
   SessionIndex store_;  // used on pool_'s thread only
   boost::asio::ip::tcp::acceptor acceptor_;
+  boost::asio::steady_timer accept_pause_;  // after a failed accept (EMFILE): a pause, not a spin
   int port_ = 0;
+  std::uint64_t initial_counter_ = 0;
   std::shared_ptr<int> open_ = std::make_shared<int>(0);  // connections now; shared with them, which may outlive us
   boost::asio::thread_pool pool_{1};  // last: its thread uses store_
 };

@@ -4,6 +4,7 @@
 
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <stdexcept>
@@ -43,12 +44,19 @@ CREATE TABLE IF NOT EXISTS sessions (
 );
 CREATE INDEX IF NOT EXISTS sessions_by_uid ON sessions (uid, id);
 CREATE INDEX IF NOT EXISTS sessions_by_state ON sessions (state);
--- The uid registry's record (several hosts, manager/uid_registry.hpp): the home this host, as an acceptor,
--- answered for each uid it was asked about. A row, once committed, never changes.
-CREATE TABLE IF NOT EXISTS uid_homes (
-  uid        TEXT PRIMARY KEY,
-  host       TEXT NOT NULL,
-  claimed_at TEXT                       -- ISO 8601 UTC
+)sql";
+
+// The uid registry's acceptor (several hosts, manager/uid_registry.hpp): what this host promised and accepted
+// for each uid it was asked about. A row is written, and committed, before the answer that depends on it.
+constexpr const char* kRegistrySchema = R"sql(
+CREATE TABLE IF NOT EXISTS uid_acceptors (
+  uid               TEXT PRIMARY KEY,
+  promised_counter  INTEGER NOT NULL DEFAULT 0,   -- the highest ballot promised: counter, proposer
+  promised_proposer TEXT NOT NULL DEFAULT '',
+  accepted_counter  INTEGER NOT NULL DEFAULT 0,   -- the ballot of the value accepted (0: none)
+  accepted_proposer TEXT NOT NULL DEFAULT '',
+  accepted_value    TEXT NOT NULL DEFAULT '',     -- a host id, '' when none
+  updated_at        TEXT                          -- ISO 8601 UTC
 );
 )sql";
 
@@ -179,6 +187,7 @@ SessionIndex::SessionIndex(const std::string& path, int busy_timeout_ms) : path_
     exec("PRAGMA synchronous = FULL");
     exec(kSchema);
     add_missing_columns();
+    prepare_registry_table();
   } catch (const std::exception& error) {
     sqlite3_close(db_);
     db_ = nullptr;
@@ -344,23 +353,60 @@ std::vector<Session> SessionIndex::recent(int limit) {
   return query("ORDER BY id DESC LIMIT " + std::to_string(limit), {});
 }
 
-std::string SessionIndex::claim_uid_home(const std::string& uid, const std::string& host, WallTime claimed_at) {
-  // OR IGNORE keeps the first record: an acceptor answers one home per uid, forever.
-  Statement insert(db_, "INSERT OR IGNORE INTO uid_homes (uid, host, claimed_at) VALUES (?,?,?)");
-  insert.bind(1, uid);
-  insert.bind(2, host);
-  insert.bind(3, iso_utc(claimed_at));
-  insert.step();
-  const auto home = uid_home(uid);
-  if (!home) throw std::runtime_error("session index: uid_homes lost the record of " + uid);
-  return *home;
+void SessionIndex::prepare_registry_table() {
+  bool had_acceptors = false;
+  bool had_first_wins = false;
+  {
+    Statement tables(db_,
+                     "SELECT name FROM sqlite_master WHERE type = 'table' AND name IN ('uid_acceptors', 'uid_homes')");
+    while (tables.step()) {
+      had_acceptors = had_acceptors || tables.text(0) == "uid_acceptors";
+      had_first_wins = had_first_wins || tables.text(0) == "uid_homes";
+    }
+  }
+  // The first registry kept one first-answered home per uid (uid_homes); its records are no Paxos state, and
+  // nothing shipped with it: dropped, and the start-up warning about a new registry table says so.
+  if (had_first_wins) exec("DROP TABLE uid_homes");
+  exec(kRegistrySchema);
+  registry_created_ = !had_acceptors;
 }
 
-std::optional<std::string> SessionIndex::uid_home(const std::string& uid) {
-  Statement select(db_, "SELECT host FROM uid_homes WHERE uid = ?");
+AcceptorState SessionIndex::uid_acceptor(const std::string& uid) {
+  Statement select(db_,
+                   "SELECT promised_counter, promised_proposer, accepted_counter, accepted_proposer, accepted_value "
+                   "FROM uid_acceptors WHERE uid = ?");
   select.bind(1, uid);
-  if (!select.step()) return std::nullopt;
-  return select.text(0);
+  AcceptorState state;
+  if (!select.step()) return state;
+  state.promised = Ballot{static_cast<std::uint64_t>(select.integer(0)), select.text(1)};
+  state.accepted = Ballot{static_cast<std::uint64_t>(select.integer(2)), select.text(3)};
+  state.value = select.text(4);
+  return state;
+}
+
+std::uint64_t SessionIndex::max_uid_ballot_counter() {
+  Statement select(db_, "SELECT MAX(promised_counter) FROM uid_acceptors");
+  if (!select.step() || select.is_null(0)) return 0;
+  return static_cast<std::uint64_t>(std::max<std::int64_t>(0, select.integer(0)));
+}
+
+void SessionIndex::set_uid_acceptor(const std::string& uid, const AcceptorState& state, WallTime now) {
+  // SQLite's integers are signed 64-bit (parse_message refuses larger counters).
+  if (state.promised.counter > kMaxBallotCounter ||
+      state.accepted.counter > kMaxBallotCounter) {
+    throw std::runtime_error("session index: ballot counter of uid " + uid + " out of range");
+  }
+  Statement upsert(db_,
+                   "INSERT OR REPLACE INTO uid_acceptors (uid, promised_counter, promised_proposer, accepted_counter, "
+                   "accepted_proposer, accepted_value, updated_at) VALUES (?,?,?,?,?,?,?)");
+  upsert.bind(1, uid);
+  upsert.bind(2, static_cast<std::int64_t>(state.promised.counter));
+  upsert.bind(3, state.promised.proposer);
+  upsert.bind(4, static_cast<std::int64_t>(state.accepted.counter));
+  upsert.bind(5, state.accepted.proposer);
+  upsert.bind(6, state.value);
+  upsert.bind(7, iso_utc(now));
+  upsert.step();
 }
 
 std::vector<std::pair<SessionState, std::int64_t>> SessionIndex::count_by_state() {

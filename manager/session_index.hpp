@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "session.hpp"
+#include "uid_registry.hpp"
 
 struct sqlite3;
 
@@ -56,17 +57,25 @@ class SessionIndex {
   /// Sessions per state over the whole index.
   std::vector<std::pair<SessionState, std::int64_t>> count_by_state();
 
-  /// The uid registry's acceptor: records `host` as `uid`'s home unless the uid has one, and returns the
-  /// home recorded (committed before it returns; throws std::runtime_error on index errors).
-  std::string claim_uid_home(const std::string& uid, const std::string& host, WallTime claimed_at);
-  /// The home recorded for `uid`, if any.
-  std::optional<std::string> uid_home(const std::string& uid);
+  /// The uid registry's acceptor state for `uid` (nothing promised or accepted when it has no row).
+  AcceptorState uid_acceptor(const std::string& uid);
+  /// Records `state` as `uid`'s acceptor state, committed before it returns; throws std::runtime_error on
+  /// index errors (a counter past 2^63-1 included). `now`: when, for the researcher reading the table.
+  void set_uid_acceptor(const std::string& uid, const AcceptorState& state, WallTime now);
+  /// The highest ballot counter this acceptor promised for any uid (0: none): a restarted proposer starts
+  /// above it, instead of learning it from one refused ballot per uid.
+  std::uint64_t max_uid_ballot_counter();
+  /// Whether opening this index created the uid registry's table: a new index, or one whose records were
+  /// lost (rebuilt, deleted, or the first registry's table dropped). Several hosts warn about it.
+  [[nodiscard]] bool registry_table_created() const { return registry_created_; }
 
  private:
   std::vector<Session> query(const std::string& where, const std::vector<std::string>& binds);
   void exec(const char* sql);
   void add_missing_columns();
+  void prepare_registry_table();
   sqlite3* db_ = nullptr;
+  bool registry_created_ = false;
   std::string path_;
 };
 

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The uid registry with three real sim_manager processes on loopback (no balancer: the test follows the
-// redirects itself): a uid's first host keeps it, the others send its participant there, concurrent starts
-// on every host make one session, a killed or restarted home keeps its uids, two hosts down means "try again"
-// with nothing created, and a claim signed with another secret is refused.
+// The uid registry with real sim_manager processes on loopback (no balancer: the test follows the redirects
+// itself): a uid's first host keeps it, the others send its participant there, concurrent starts on every
+// host make one session, a killed or restarted home keeps its uids, two hosts down means "try again" with
+// nothing created, two hosts down in turn lock nothing out, a split left by earlier ballots is finished, and
+// the registry port refuses forged, stale, misaddressed and foreign-list lines.
 #include <catch2/catch.hpp>
 
 #include <arpa/inet.h>
@@ -14,6 +15,7 @@
 #include <openssl/evp.h>
 #include <openssl/hmac.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <fstream>
@@ -50,6 +52,23 @@ std::string hmac_hex(const std::string& secret, const std::string& text) {
   return hex;
 }
 
+// The registry's message key for these peers ("id=address:port" lines, sorted), derived here again.
+std::string registry_key(const std::string& secret, std::vector<std::string> peer_lines) {
+  std::sort(peer_lines.begin(), peer_lines.end());
+  std::string text = "rfbsim-registry-v2\n";
+  for (const std::string& line : peer_lines) text += line + "\n";
+  return hmac_hex(secret, text);
+}
+
+// `text` and its hmac under `key`, as one line.
+std::string signed_line(const std::string& key, const std::string& text) {
+  return text + " " + hmac_hex(key, text) + "\n";
+}
+
+long long unix_now() {
+  return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
 // A loopback port that was free a moment ago.
 int free_port() {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
@@ -83,26 +102,31 @@ std::string ask_registry(int port, const std::string& text) {
   return answer;
 }
 
-// Three hosts h1..h3 with their registries on fixed loopback ports, each in a data folder of its own.
+// Hosts h1..hN with their registries on fixed loopback ports, each in a data folder of its own.
 class Cluster {
  public:
-  Cluster() {
+  explicit Cluster(int hosts = 3) : count_(hosts) {
     secret_file_ = (secret_dir_.path() / "cluster.secret").string();
     std::ofstream(secret_file_) << kSecret << "\n";
     ::chmod(secret_file_.c_str(), 0600);
     std::string peers;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < count_; ++i) {
       registry_ports_.push_back(free_port());
-      peers += (i == 0 ? "" : ",") + id(i) + "=127.0.0.1:" + std::to_string(registry_ports_.back());
+      peer_lines_.push_back(id(i) + "=127.0.0.1:" + std::to_string(registry_ports_.back()));
+      peers += (i == 0 ? "" : ",") + peer_lines_.back();
     }
     peers_ = peers;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < count_; ++i) {
       data_.push_back(std::make_unique<TempDir>("rfbsim-registry-test"));
       hosts_.emplace_back();
       start(i);
     }
   }
 
+  [[nodiscard]] int size() const { return count_; }
+  // The message key every host of this cluster signs with.
+  [[nodiscard]] std::string key() const { return registry_key(kSecret, peer_lines_); }
+  [[nodiscard]] const std::vector<std::string>& peer_lines() const { return peer_lines_; }
   static std::string id(int i) { return "h" + std::to_string(i + 1); }
   ManagerUnderTest& host(int i) { return *hosts_.at(static_cast<std::size_t>(i)); }
   [[nodiscard]] int registry_port(int i) const { return registry_ports_.at(static_cast<std::size_t>(i)); }
@@ -122,10 +146,10 @@ class Cluster {
   // kill -9: its sessions die with it (PR_SET_PDEATHSIG).
   void kill(int i) { host(i).process().stop(SIGKILL, 5s); }
 
-  // The rows of `uid` in all three indexes, as (host index, row).
+  // The rows of `uid` in every host's index (read from its file, whether the host runs or not).
   std::vector<std::pair<int, rfbsim::test::IndexRow>> rows_of(const std::string& uid) {
     std::vector<std::pair<int, rfbsim::test::IndexRow>> out;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < count_; ++i) {
       for (const auto& row : host(i).index_rows()) {
         if (row.uid == uid) out.emplace_back(i, row);
       }
@@ -143,9 +167,11 @@ class Cluster {
   }
 
  private:
+  int count_;
   TempDir secret_dir_{"rfbsim-registry-secret"};
   std::string secret_file_;
   std::string peers_;
+  std::vector<std::string> peer_lines_;
   std::vector<int> registry_ports_;
   std::vector<std::unique_ptr<TempDir>> data_;
   std::vector<std::unique_ptr<ManagerUnderTest>> hosts_;
@@ -162,7 +188,7 @@ std::string token_of(const net::HttpResponse& response, const std::string& host_
 
 }  // namespace
 
-TEST_CASE("a uid's first host keeps it; the other hosts send its participant there", "[manager][registry]") {
+TEST_CASE("a uid's first host keeps it, and the other hosts send its participant there", "[manager][registry]") {
   Cluster cluster;
   const auto first = cluster.host(1).start("uid=reg-x&scenario=demo");
   const std::string token = token_of(first, "h2");
@@ -272,25 +298,128 @@ TEST_CASE("with two of three hosts down a new uid is asked to retry and nothing 
   CHECK(cluster.host(0).index_rows().empty());
 }
 
-TEST_CASE("the registry port refuses forged, stale, malformed and overlong claims", "[manager][registry]") {
+TEST_CASE("the registry port refuses forged, stale, misaddressed, foreign-list, malformed and overlong lines",
+          "[manager][registry]") {
   Cluster cluster;
-  const int port = cluster.registry_port(0);
-  const long long now = std::chrono::duration_cast<std::chrono::seconds>(
-                            std::chrono::system_clock::now().time_since_epoch())
-                            .count();
-  auto line = [](const std::string& secret, const std::string& uid, const std::string& host, long long time) {
-    const std::string text = "claim " + uid + " " + host + " " + std::to_string(time);
-    return text + " " + hmac_hex(secret, text) + "\n";
+  const int port = cluster.registry_port(0);  // h1's acceptor
+  const std::string key = cluster.key();
+  const std::string now = std::to_string(unix_now());
+  const std::string nonce = "0123456789abcdef";
+  auto prepare = [&](const std::string& signing_key, const std::string& counter, const std::string& proposer,
+                     const std::string& acceptor, const std::string& time) {
+    return signed_line(signing_key, "prepare reg-forged " + counter + " " + proposer + " " + acceptor + " " + nonce +
+                                        " " + time);
   };
-  CHECK(ask_registry(port, line("a-forged-secret-0123456789", "reg-forged", "h3", now)) == "error bad hmac\n");
-  CHECK(ask_registry(port, line(kSecret, "reg-forged", "h3", now - 600)) == "error stale time\n");
+  CHECK(ask_registry(port, prepare(registry_key("a-forged-secret-0123456789", cluster.peer_lines()), "5", "h3", "h1",
+                                   now)) == "error bad hmac\n");
+  // The right secret on another peer list (a host started before a change of the list): another key.
+  auto other_list = cluster.peer_lines();
+  other_list.push_back("h4=127.0.0.1:1");
+  CHECK(ask_registry(port, prepare(registry_key(kSecret, other_list), "5", "h3", "h1", now)) == "error bad hmac\n");
+  CHECK(ask_registry(port, prepare(key, "5", "h3", "h1", std::to_string(unix_now() - 600))) == "error stale time\n");
+  CHECK(ask_registry(port, prepare(key, "5", "h3", "h2", now)) == "error not acceptor h2\n");
+  CHECK(ask_registry(port, prepare(key, "5", "h9", "h1", now)) == "error proposer not a peer\n");
   CHECK(ask_registry(port, "hello\n").rfind("error ", 0) == 0);
-  CHECK(ask_registry(port, std::string(300, 'x') + "\n") == "error line too long\n");
-  // The forged claim recorded nothing: the uid's first real claim decides.
-  CHECK(ask_registry(port, line(kSecret, "reg-forged", "h2", now)) ==
-        "owner h2 " + hmac_hex(kSecret, "owner reg-forged h2") + "\n");
-  CHECK(ask_registry(port, line(kSecret, "reg-forged", "h3", now)) ==
-        "owner h2 " + hmac_hex(kSecret, "owner reg-forged h2") + "\n");
+  CHECK(ask_registry(port, std::string(600, 'x') + "\n") == "error line too long\n");
+
+  // None of those changed anything: a real prepare finds nothing promised or accepted.
+  CHECK(ask_registry(port, prepare(key, "1", "h3", "h1", now)) ==
+        signed_line(key, "promise reg-forged 1 h3 h1 " + nonce + " 0 - -"));
+  CHECK(ask_registry(port, signed_line(key, "accept reg-forged 1 h3 h1 " + nonce + " " + now + " h3")) ==
+        signed_line(key, "accepted reg-forged 1 h3 h1 " + nonce));
+  // A lower ballot is refused with the promise that outranks it; a higher one learns the accepted value.
+  CHECK(ask_registry(port, prepare(key, "1", "h2", "h1", now)) ==
+        signed_line(key, "reject reg-forged 1 h2 h1 " + nonce + " 1 h3"));
+  CHECK(ask_registry(port, prepare(key, "2", "h2", "h1", now)) ==
+        signed_line(key, "promise reg-forged 2 h2 h1 " + nonce + " 1 h3 h3"));
   // The manager carries on.
   CHECK(cluster.host(0).get("/healthz").status == 200);
+}
+
+TEST_CASE("two hosts down in turn lock no uid out: once both are up, it starts on one of them",
+          "[manager][registry]") {
+  Cluster cluster(2);
+  // h2 down: h1 alone is no majority of two, so nothing is accepted anywhere.
+  cluster.kill(1);
+  CHECK(cluster.host(0).start("uid=reg-pair&scenario=demo").status == 503);
+  // Then h1 down and h2 back: the same on h2.
+  cluster.start(1);
+  cluster.kill(0);
+  CHECK(cluster.host(1).start("uid=reg-pair&scenario=demo").status == 503);
+  cluster.start(0);
+
+  // A split as the first-answer-wins registry could leave it: each acceptor accepted its own host.
+  const std::string key = cluster.key();
+  const std::string now = std::to_string(unix_now());
+  for (int i = 0; i < 2; ++i) {
+    const std::string id = Cluster::id(i);
+    const std::string text = "accept reg-split 1 " + id + " " + id + " fedcba9876543210 " + now + " " + id;
+    REQUIRE(ask_registry(cluster.registry_port(i), signed_line(key, text)) ==
+            signed_line(key, "accepted reg-split 1 " + id + " " + id + " fedcba9876543210"));
+  }
+
+  for (const char* uid : {"reg-pair", "reg-split"}) {
+    CAPTURE(uid);
+    const std::string query = std::string("uid=") + uid + "&scenario=demo";
+    auto first = cluster.host(0).start(query);
+    if (first.status == 303) first = cluster.follow(first);
+    REQUIRE(first.status == 302);
+    const auto rows = cluster.rows_of(uid);
+    REQUIRE(rows.size() == 1);
+    const std::string home = Cluster::id(rows.front().first);
+    if (std::string(uid) == "reg-split") CHECK(home == "h2");  // the higher of the two accepted ballots, 1.h2
+    // The other host agrees.
+    auto second = cluster.host(1).start(query);
+    if (second.status == 303) second = cluster.follow(second);
+    CHECK(token_of(second, home) == rows.front().second.token);
+    CHECK(cluster.rows_of(uid).size() == 1);
+  }
+}
+
+TEST_CASE("a cluster of one host decides alone", "[manager][registry]") {
+  Cluster cluster(1);
+  const std::string token = token_of(cluster.host(0).start("uid=reg-one&scenario=demo"), "h1");
+  CHECK(token.size() == 32);
+  CHECK(token_of(cluster.host(0).start("uid=reg-one&scenario=demo"), "h1") == token);
+  CHECK(cluster.rows_of("reg-one").size() == 1);
+}
+
+TEST_CASE("duelling proposers: many fresh uids started at once on every host get one session each",
+          "[manager][registry]") {
+  Cluster cluster;
+  constexpr int kUids = 8;
+  std::atomic<int> ready{0};
+  std::vector<std::vector<net::HttpResponse>> responses(kUids, std::vector<net::HttpResponse>(3));
+  std::vector<std::thread> threads;
+  for (int u = 0; u < kUids; ++u) {
+    for (int i = 0; i < 3; ++i) {
+      threads.emplace_back([&, u, i] {
+        ++ready;
+        while (ready.load() < 3 * kUids) std::this_thread::yield();
+        const std::string query = "uid=reg-duel-" + std::to_string(u) + "&scenario=demo";
+        // As a participant would: a 503 (no ballot reached a majority) is tried again in a moment.
+        net::HttpResponse response;
+        for (int attempt = 0; attempt < 10; ++attempt) {
+          response = cluster.host(i).start(query);
+          if (response.status != 503) break;
+          std::this_thread::sleep_for(200ms);
+        }
+        if (response.status == 303) response = cluster.follow(response);
+        responses[static_cast<std::size_t>(u)][static_cast<std::size_t>(i)] = response;
+      });
+    }
+  }
+  for (auto& thread : threads) thread.join();
+  for (int u = 0; u < kUids; ++u) {
+    const std::string uid = "reg-duel-" + std::to_string(u);
+    CAPTURE(uid);
+    const auto rows = cluster.rows_of(uid);
+    REQUIRE(rows.size() == 1);
+    const std::string home = Cluster::id(rows.front().first);
+    for (int i = 0; i < 3; ++i) {
+      CAPTURE(i);
+      CHECK(token_of(responses[static_cast<std::size_t>(u)][static_cast<std::size_t>(i)], home) ==
+            rows.front().second.token);
+    }
+  }
 }
