@@ -62,14 +62,23 @@ void close_with(Connection& connection, SessionState state) {
 
 // The PROXY protocol line that tells a session which browser a relayed connection is for.
 template <typename Connection>
-std::string proxy_line_for(Connection& con) {
+// The PROXY line naming the browser to the session: the socket's peer, or `forwarded` (whom a trusted
+// balancer names in X-Forwarded-For) when given. The balancer's port says nothing about the participant, so
+// that line carries port 0 and an unspecified destination of the participant's family.
+std::string proxy_line_for(Connection& con, const std::string& forwarded) {
   boost::system::error_code ec;
   auto& socket = con.get_raw_socket().lowest_layer();
   const auto remote = socket.remote_endpoint(ec);
   if (ec) return "PROXY UNKNOWN\r\n";
   const auto local = socket.local_endpoint(ec);
   if (ec) return "PROXY UNKNOWN\r\n";
-  return proxy_line(remote, local);
+  if (forwarded.empty()) return proxy_line(remote, local);
+  const auto named = boost::asio::ip::make_address(forwarded, ec);
+  if (ec) return proxy_line(remote, local);
+  const boost::asio::ip::address unspecified =
+      named.is_v4() ? boost::asio::ip::address(boost::asio::ip::address_v4::any())
+                    : boost::asio::ip::address(boost::asio::ip::address_v6::any());
+  return proxy_line({named, 0}, {unspecified, local.port()});
 }
 
 std::string read_file(const std::filesystem::path& path, bool& ok) {
@@ -409,17 +418,39 @@ class FrontendImpl final : public Frontend, public SessionListener {
       });
       return;
     }
+    if (claim == Claim::kLearn) {
+      con->defer_http_response();
+      registry_->learn(parsed.request->uid, [this, con, query = route.query](const LearnResult& result) {
+        if (const auto home = learned_redirect(result, config_.host_id)) {
+          // The uid lives on another host (the balancer's pool may land on a full host that is not its home):
+          // the participant goes there, as after a claim that another host won.
+          const std::string location = "/" + *home + "/start?" + query;
+          respond_page(con, 303, "<!DOCTYPE html><title>Moved</title><a href=\"" + html_escape(location) +
+                                     "\">Continue</a>\n",
+                       {{"Location", location}});
+        } else {
+          // No home yet, this host's own (claimed, never started, and no room now), or nothing learned: busy,
+          // as before. This round proposed nothing of its own, so trying another host is safe.
+          metrics_.count_rejection(Rejection::kBusy);
+          respond_page(con, 503, busy_page(kBusyRetrySeconds), {{"Retry-After", std::to_string(kBusyRetrySeconds)}});
+        }
+        websocketpp::lib::error_code ec;
+        con->send_http_response(ec);  // a browser that left meanwhile costs nothing
+      });
+      return;
+    }
     start_session(con, *parsed.request, address, false);
   }
 
   // Whether /start of `uid` must ask the uid registry first.
   enum class Claim {
-    kNo,       // this host has a session of the uid, or could not start one anyway
+    kNo,       // this host has a session of the uid, or is shutting down
     kYes,      // a uid new here, and a free slot: the registry decides where it starts
+    kLearn,    // a uid new here, but full or draining: the registry only tells whether it lives elsewhere
     kUnknown,  // the index could not be read: the participant retries in a moment
   };
   // A full or draining host claims nothing (its busy page sends the participant elsewhere, and nothing was
-  // recorded).
+  // recorded); it only learns whether the uid already has a home on another host, to send it there.
   Claim needs_claim(const std::string& uid) {
     try {
       if (supervisor_.has_session_for_uid(uid)) return Claim::kNo;
@@ -428,8 +459,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
                    error.what());
       return Claim::kUnknown;
     }
-    const bool can_start = !supervisor_.table().full() && !supervisor_.draining() && !supervisor_.shutting_down();
-    return can_start ? Claim::kYes : Claim::kNo;
+    if (supervisor_.shutting_down()) return Claim::kNo;
+    return supervisor_.table().full() || supervisor_.draining() ? Claim::kLearn : Claim::kYes;
   }
 
   // Admits `request` on this host; `deferred`: the response was deferred already (after a claim round).
@@ -749,7 +780,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
     // sim_rfb records it as a watcher and it does not start the participant's task clock.
     if (config_.session_kind == SessionKind::kSimRfb) {
       relay->set_proxy_line(kind == RelayKind::kWatch ? std::string("PROXY UNKNOWN view-only\r\n")
-                                                      : proxy_line_for(*con));
+                                                      : proxy_line_for(*con, intake_.forwarded_participant_of(con)));
     }
     if (session->state == SessionState::kRunning) relay->connect(session->port, session->unix_socket);
   }

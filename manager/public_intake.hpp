@@ -91,6 +91,17 @@ class PublicIntake {
         client_address(remote.address().to_string(), con->get_request_header("X-Forwarded-For"), trusted_proxies_));
   }
 
+  /// The participant a trusted front end names in X-Forwarded-For (whole, not its /64), for the PROXY line
+  /// the relay sends its session; "" when the peer itself is the participant (or the socket is gone).
+  std::string forwarded_participant_of(const ConnectionPtr& con) {
+    boost::system::error_code ec;
+    const auto remote = con->get_raw_socket().lowest_layer().remote_endpoint(ec);
+    if (ec) return "";
+    const std::string peer = remote.address().to_string();
+    const std::string named = client_address(peer, con->get_request_header("X-Forwarded-For"), trusted_proxies_);
+    return named == client_address(peer, "", trusted_proxies_) ? "" : named;
+  }
+
   /// Public connections open now, and from how many addresses (for /metrics).
   std::size_t open_total() const { return limits_.open_total(); }
   std::size_t addresses() const { return limits_.addresses(); }

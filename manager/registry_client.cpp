@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// A claim: ballots of two phases each, every peer asked at once; peer names resolved in the background.
+// A claim or a learn-only round: ballots of two phases each, every peer asked at once; peer names resolved in
+// the background.
 #include "registry_client.hpp"
 
 #include <boost/asio/post.hpp>
@@ -46,10 +47,12 @@ struct RegistryClient::Remote {
 };
 
 struct RegistryClient::Round {
-  Round(asio::io_context& io, std::string uid_, Decided done_)
-      : uid(std::move(uid_)), done(std::move(done_)), pause(io) {}
+  Round(asio::io_context& io, std::string uid_, bool learn_only_, Learned done_)
+      : uid(std::move(uid_)), learn_only(learn_only_), done(std::move(done_)), pause(io) {}
   std::string uid;
-  Decided done;
+  bool learn_only;  // never propose this host: confirm a value a promise reported, or end kUnknown
+  Learned done;
+  std::string proposal;      // what the current ballot's phase 2 proposes
   asio::steady_timer pause;  // before a retry
   int attempt = 0;           // ballots tried so far
   Ballot ballot;             // the current ballot
@@ -142,14 +145,20 @@ void RegistryClient::resolve(const std::shared_ptr<Remote>& remote) {
 }
 
 void RegistryClient::claim(const std::string& uid, Decided done) {
-  run_ballot(std::make_shared<Round>(io_, uid, std::move(done)));
+  run_ballot(std::make_shared<Round>(io_, uid, false, [done = std::move(done)](const LearnResult& result) {
+    done(result.kind == LearnKind::kDecided ? std::optional<std::string>(result.home) : std::nullopt);
+  }));
+}
+
+void RegistryClient::learn(const std::string& uid, Learned done) {
+  run_ballot(std::make_shared<Round>(io_, uid, true, std::move(done)));
 }
 
 void RegistryClient::run_ballot(const std::shared_ptr<Round>& round) {
   ++round->attempt;
   if (counter_ >= kMaxBallotCounter) {
     std::fprintf(stderr, "[registry] uid %s: ballot counters are used up\n", round->uid.c_str());
-    round->done(std::nullopt);
+    round->done(LearnResult{});
     return;
   }
   round->ballot = Ballot{++counter_, self_};
@@ -165,7 +174,7 @@ void RegistryClient::run_phase(const std::shared_ptr<Round>& round, MessageKind 
   phase->request.ballot = round->ballot;
   phase->request.nonce = round->nonce;
   phase->request.unix_time = unix_now();
-  if (kind == MessageKind::kAccept) phase->request.value = round->tally->value();
+  if (kind == MessageKind::kAccept) phase->request.value = round->proposal;
 
   // One timeout for the whole phase: whoever has not answered by then counts as silent.
   phase->timer.expires_after(phase_timeout_);
@@ -258,19 +267,28 @@ void RegistryClient::settle(const std::shared_ptr<Phase>& phase) {
   counter_ = std::max(counter_, round->tally->highest_counter());
   if (progress == BallotTally::Progress::kFailed) return retry_or_give_up(round);
   if (phase->request.kind == MessageKind::kPrepare) {
+    if (round->learn_only) {
+      const std::optional<std::string> learned = round->tally->learned_value();
+      // No promise of this majority reports a value, so no value was decided (any decided one would show in
+      // every majority): there is nothing to learn, and a learn-only round proposes nothing of its own.
+      if (!learned) return round->done(LearnResult{LearnKind::kUnknown, ""});
+      round->proposal = *learned;
+    } else {
+      round->proposal = round->tally->value();
+    }
     round->tally->begin_accept();
     run_phase(round, MessageKind::kAccept);
     return;
   }
   // A majority accepted this value at this ballot: it is decided, for good.
-  round->done(phase->request.value);
+  round->done(LearnResult{LearnKind::kDecided, phase->request.value});
 }
 
 void RegistryClient::retry_or_give_up(const std::shared_ptr<Round>& round) {
   if (round->attempt >= kAttempts) {
-    std::fprintf(stderr, "[registry] uid %s: no home decided after %d ballots; the participant retries\n",
-                 round->uid.c_str(), round->attempt);
-    round->done(std::nullopt);
+    std::fprintf(stderr, "[registry] uid %s: no home %s after %d ballots; the participant retries\n",
+                 round->uid.c_str(), round->learn_only ? "learned" : "decided", round->attempt);
+    round->done(LearnResult{});
     return;
   }
   std::uniform_int_distribution<int> pause_ms(kRetryPauseMinMs, kRetryPauseMaxMs);

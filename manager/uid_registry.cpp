@@ -179,6 +179,16 @@ void BallotTally::begin_accept() {
 
 const std::string& BallotTally::value() const { return best_accepted_.empty() ? self_ : best_value_; }
 
+std::optional<std::string> BallotTally::learned_value() const {
+  if (best_accepted_.empty()) return std::nullopt;
+  return best_value_;
+}
+
+std::optional<std::string> learned_redirect(const LearnResult& result, const std::string& self) {
+  if (result.kind != LearnKind::kDecided || result.home.empty() || result.home == self) return std::nullopt;
+  return result.home;
+}
+
 // --- Lines --------------------------------------------------------------------------------------------------
 
 std::string registry_key(std::string_view secret, const std::vector<ClusterPeer>& peers) {

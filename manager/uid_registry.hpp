@@ -105,6 +105,9 @@ class BallotTally {
   void begin_accept();
   /// What phase 2 proposes: the value of the highest accepted ballot among the promises, else this host.
   [[nodiscard]] const std::string& value() const;
+  /// What a learn-only round's phase 2 proposes: the value of the highest accepted ballot among the promises,
+  /// or nothing when no promise reported one (that round then ends "unknown" without a phase 2).
+  [[nodiscard]] std::optional<std::string> learned_value() const;
   /// The highest ballot counter any answer named (accepted or promised ballots): the next ballot goes above.
   [[nodiscard]] std::uint64_t highest_counter() const { return highest_counter_; }
   /// How many acceptors answered yes in the current phase.
@@ -120,6 +123,27 @@ class BallotTally {
   std::string best_value_;
   std::uint64_t highest_counter_ = 0;
 };
+
+/// How a learn-only round ended. Such a round never proposes its own host: it only finishes what a majority
+/// may already have decided, so a full or draining host can send a uid's participant to the uid's home
+/// without ever becoming that home.
+enum class LearnKind {
+  kDecided,    ///< phase 2 of this round got a majority to accept `home`: the uid's home, for good
+  kUnknown,    ///< a majority promised and none had accepted a value: no home yet, and none was proposed
+  kUndecided,  ///< no ballot got a majority (too many peers down, or outbid each time): nothing learned
+};
+
+/// A learn-only round's result: its kind and, when decided, the uid's home.
+struct LearnResult {
+  LearnKind kind = LearnKind::kUndecided;
+  std::string home;  ///< the decided home ("" unless kDecided)
+};
+
+/// Where a host that may not start `uid` (full, draining) sends its participant after a learn-only round:
+/// the decided home when that is another host, else nothing (the busy page; the balancer or the participant
+/// tries elsewhere, which is safe because nothing was claimed). A home of `self` is nothing too: this host
+/// owns the uid but has no room for it now.
+std::optional<std::string> learned_redirect(const LearnResult& result, const std::string& self);
 
 /// The message key: hex HMAC-SHA256(secret, "rfbsim-registry-v2\n" + the peers as "id=address:port\n"
 /// lines, sorted). Hosts on different peer lists get different keys and cannot count each other's answers.

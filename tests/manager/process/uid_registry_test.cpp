@@ -2,8 +2,9 @@
 // The uid registry with real sim_manager processes on loopback (no balancer: the test follows the redirects
 // itself): a uid's first host keeps it, the others send its participant there, concurrent starts on every
 // host make one session, a killed or restarted home keeps its uids, two hosts down means "try again" with
-// nothing created, two hosts down in turn lock nothing out, a split left by earlier ballots is finished, and
-// the registry port refuses forged, stale, misaddressed and foreign-list lines.
+// nothing created, two hosts down in turn lock nothing out, a split left by earlier ballots is finished, a full
+// or drained host sends a uid that lives elsewhere to its home but claims no new one, and the registry port
+// refuses forged, stale, misaddressed and foreign-list lines.
 #include <catch2/catch.hpp>
 
 #include <arpa/inet.h>
@@ -14,6 +15,7 @@
 
 #include <openssl/evp.h>
 #include <openssl/hmac.h>
+#include <sqlite3.h>
 
 #include <algorithm>
 #include <atomic>
@@ -105,7 +107,8 @@ std::string ask_registry(int port, const std::string& text) {
 // Hosts h1..hN with their registries on fixed loopback ports, each in a data folder of its own.
 class Cluster {
  public:
-  explicit Cluster(int hosts = 3) : count_(hosts) {
+  // `max_sessions`: each host's slots (1 makes a host with one live session full).
+  explicit Cluster(int hosts = 3, int max_sessions = 8) : count_(hosts), max_sessions_(max_sessions) {
     secret_file_ = (secret_dir_.path() / "cluster.secret").string();
     std::ofstream(secret_file_) << kSecret << "\n";
     ::chmod(secret_file_.c_str(), 0600);
@@ -140,7 +143,8 @@ class Cluster {
         rfbsim::test::without_abuse_limits(
             {"--host-id", id(i), "--cluster-peers", peers_, "--cluster-secret-file", secret_file_,
              "--session-kind", "rfb", "--session-command", RFBSIM_MINIMAL, "--session-arg", "{port}",
-             "--scenarios", "demo", "--max-sessions", "8", "--admin-token", kAdminToken}));
+             "--scenarios", "demo", "--max-sessions", std::to_string(max_sessions_), "--admin-token",
+             kAdminToken}));
   }
 
   // kill -9: its sessions die with it (PR_SET_PDEATHSIG).
@@ -157,6 +161,26 @@ class Cluster {
     return out;
   }
 
+  // The value host i's acceptor accepted for `uid` ("" when none), read from its sessions.db.
+  std::string accepted_value(int i, const std::string& uid) {
+    const std::string path = (data_.at(static_cast<std::size_t>(i))->path() / "sessions.db").string();
+    sqlite3* db = nullptr;
+    std::string value;
+    if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+      sqlite3_stmt* select = nullptr;
+      if (sqlite3_prepare_v2(db, "SELECT accepted_value FROM uid_acceptors WHERE uid = ?", -1, &select, nullptr) ==
+          SQLITE_OK) {
+        sqlite3_bind_text(select, 1, uid.c_str(), -1, SQLITE_TRANSIENT);
+        if (sqlite3_step(select) == SQLITE_ROW && sqlite3_column_text(select, 0) != nullptr) {
+          value = reinterpret_cast<const char*>(sqlite3_column_text(select, 0));
+        }
+      }
+      sqlite3_finalize(select);
+    }
+    sqlite3_close(db);
+    return value;
+  }
+
   // GET of a Location the balancer would route by its /hN prefix.
   net::HttpResponse follow(const net::HttpResponse& redirect) {
     const std::string& location = redirect.headers.at("location");
@@ -168,6 +192,7 @@ class Cluster {
 
  private:
   int count_;
+  int max_sessions_;
   TempDir secret_dir_{"rfbsim-registry-secret"};
   std::string secret_file_;
   std::string peers_;
@@ -184,6 +209,13 @@ std::string token_of(const net::HttpResponse& response, const std::string& host_
   const std::string prefix = "/" + host_id + "/s/";
   if (location.rfind(prefix, 0) != 0 || location.size() != prefix.size() + 33) return "";
   return location.substr(prefix.size(), 32);
+}
+
+// A POST to the admin API, with the admin token and header.
+net::HttpResponse admin_post(const ManagerUnderTest& manager, const std::string& path) {
+  return net::http_request(manager.port(), "POST " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " +
+                                               kAdminToken + "\r\nX-Rfbsim-Admin: 1\r\nContent-Length: 0\r\n" +
+                                               "Connection: close\r\n\r\n");
 }
 
 }  // namespace
@@ -296,6 +328,67 @@ TEST_CASE("with two of three hosts down a new uid is asked to retry and nothing 
   CHECK(response.headers.at("retry-after") == "5");
   CHECK(response.body.find("try again") != std::string::npos);
   CHECK(cluster.host(0).index_rows().empty());
+}
+
+TEST_CASE("a full or drained host sends a uid that lives elsewhere to its home, and claims no new uid",
+          "[manager][registry]") {
+  Cluster cluster(3, 1);  // one slot each: a host with one live session is full
+  const std::string home_token = token_of(cluster.host(1).start("uid=reg-elsewhere&scenario=demo"), "h2");
+  REQUIRE(home_token.size() == 32);
+  REQUIRE(token_of(cluster.host(0).start("uid=reg-filler&scenario=demo"), "h1").size() == 32);
+  auto claimed_nowhere = [&](const std::string& uid) {
+    CHECK(cluster.rows_of(uid).empty());
+    for (int i = 0; i < 3; ++i) {
+      CAPTURE(uid, i);
+      CHECK(cluster.accepted_value(i, uid).empty());
+    }
+  };
+
+  // h1 is full: a uid whose home is h2 goes there (as a participant whose link the pool sent here would),
+  // and its session is the one h2 has.
+  const auto moved = cluster.host(0).start("uid=reg-elsewhere&scenario=demo");
+  REQUIRE(moved.status == 303);
+  CHECK(moved.headers.at("location") == "/h2/start?uid=reg-elsewhere&scenario=demo");
+  CHECK(token_of(cluster.follow(moved), "h2") == home_token);
+  // A new uid gets the busy page, and no host records a home for it.
+  const auto busy = cluster.host(0).start("uid=reg-fresh&scenario=demo");
+  CHECK(busy.status == 503);
+  CHECK(busy.headers.count("retry-after") == 1);
+  CHECK(busy.body.find("All simulators are busy") != std::string::npos);
+  claimed_nowhere("reg-fresh");
+
+  // A home decided for full h1 whose session never started (accepted by h1 and h2, forged here): h1 has no
+  // room, so busy; full h2 learns it and sends the participant to h1.
+  const std::string key = cluster.key();
+  const std::string now = std::to_string(unix_now());
+  for (int i = 0; i < 2; ++i) {
+    const std::string id = Cluster::id(i);
+    const std::string text = "accept reg-owned 1 h1 " + id + " fedcba9876543210 " + now + " h1";
+    REQUIRE(ask_registry(cluster.registry_port(i), signed_line(key, text)) ==
+            signed_line(key, "accepted reg-owned 1 h1 " + id + " fedcba9876543210"));
+  }
+  CHECK(cluster.host(0).start("uid=reg-owned&scenario=demo").status == 503);
+  const auto to_owner = cluster.host(1).start("uid=reg-owned&scenario=demo");
+  CHECK(to_owner.status == 303);
+  CHECK(to_owner.headers.at("location") == "/h1/start?uid=reg-owned&scenario=demo");
+  CHECK(cluster.rows_of("reg-owned").empty());
+
+  // h3 has a free slot but is drained by the operator: the same answers.
+  REQUIRE(admin_post(cluster.host(2), "/api/drain").status == 200);
+  const auto drained_moved = cluster.host(2).start("uid=reg-elsewhere&scenario=demo");
+  CHECK(drained_moved.status == 303);
+  CHECK(drained_moved.headers.at("location") == "/h2/start?uid=reg-elsewhere&scenario=demo");
+  const auto drained_busy = cluster.host(2).start("uid=reg-fresh&scenario=demo");
+  CHECK(drained_busy.status == 503);
+  CHECK(drained_busy.body.find("All simulators are busy") != std::string::npos);
+  claimed_nowhere("reg-fresh");
+
+  // Taking new sessions again, h3 claims the fresh uid for itself: nothing earlier had claimed it elsewhere.
+  REQUIRE(admin_post(cluster.host(2), "/api/undrain").status == 200);
+  CHECK(token_of(cluster.host(2).start("uid=reg-fresh&scenario=demo"), "h3").size() == 32);
+  const auto rows = cluster.rows_of("reg-fresh");
+  REQUIRE(rows.size() == 1);
+  CHECK(rows.front().first == 2);
 }
 
 TEST_CASE("the registry port refuses forged, stale, misaddressed, foreign-list, malformed and overlong lines",

@@ -7,6 +7,7 @@
 #include <deque>
 #include <map>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,9 @@ using rfbsim::manager::format_message;
 using rfbsim::manager::hmac_sha256_hex;
 using rfbsim::manager::is_host_id;
 using rfbsim::manager::kMaxRegistryLine;
+using rfbsim::manager::LearnKind;
+using rfbsim::manager::learned_redirect;
+using rfbsim::manager::LearnResult;
 using rfbsim::manager::MessageKind;
 using rfbsim::manager::parse_manager_args;
 using rfbsim::manager::parse_message;
@@ -196,6 +200,64 @@ TEST_CASE("a ballot's tally: majorities of distinct acceptors, the highest accep
   }
 }
 
+TEST_CASE("a learn-only round proposes only a value some promise reported, never its own host", "[uid_registry]") {
+  SECTION("no promise reports a value: unknown, where a claim would propose itself") {
+    BallotTally tally("h1", kThree);
+    tally.promised("h1", {}, "");
+    tally.promised("h3", {}, "");
+    REQUIRE(tally.progress() == Progress::kMajority);
+    CHECK_FALSE(tally.learned_value());
+    CHECK(tally.value() == "h1");
+  }
+  SECTION("the highest accepted ballot's value, even when a lower one named this host") {
+    BallotTally tally("h1", kThree);
+    tally.promised("h1", {2, "h1"}, "h1");
+    tally.promised("h3", {3, "h2"}, "h2");
+    CHECK(tally.learned_value() == std::optional<std::string>("h2"));
+  }
+  SECTION("a value this host claimed earlier is learned too") {
+    BallotTally tally("h1", kThree);
+    tally.promised("h2", {1, "h1"}, "h1");
+    CHECK(tally.learned_value() == std::optional<std::string>("h1"));
+  }
+}
+
+TEST_CASE("a full or draining host sends a participant only to another host's decided home", "[uid_registry]") {
+  CHECK(learned_redirect(LearnResult{LearnKind::kDecided, "h2"}, "h1") == std::optional<std::string>("h2"));
+  // Its own home (claimed, never started) has no room here now: busy, not a redirect to itself.
+  CHECK_FALSE(learned_redirect(LearnResult{LearnKind::kDecided, "h1"}, "h1"));
+  CHECK_FALSE(learned_redirect(LearnResult{LearnKind::kUnknown, ""}, "h1"));
+  CHECK_FALSE(learned_redirect(LearnResult{LearnKind::kUndecided, ""}, "h1"));
+  CHECK_FALSE(learned_redirect(LearnResult{LearnKind::kDecided, ""}, "h1"));
+}
+
+TEST_CASE("a learn-only round over a fresh uid accepts nothing anywhere, and the next claim decides its host",
+          "[uid_registry]") {
+  std::map<std::string, AcceptorState> acceptors;
+  BallotTally learner("h1", kThree);
+  for (const std::string id : {"h1", "h2", "h3"}) {
+    const RegistryMessage answer = acceptor_answer(acceptors[id], prepare("p01", {1, "h1"}, id));
+    REQUIRE(answer.kind == MessageKind::kPromise);
+    learner.promised(id, answer.other, answer.value);
+  }
+  REQUIRE(learner.progress() == Progress::kMajority);
+  CHECK_FALSE(learner.learned_value());  // unknown: no phase 2
+  for (const auto& [id, state] : acceptors) {
+    CAPTURE(id);
+    CHECK(state.accepted.empty());
+    CHECK(state.value.empty());
+  }
+  // h3 claims it with a higher ballot and gets it.
+  BallotTally claimer("h3", kThree);
+  for (const std::string id : {"h1", "h2"}) {
+    const RegistryMessage answer = acceptor_answer(acceptors[id], prepare("p01", {2, "h3"}, id));
+    REQUIRE(answer.kind == MessageKind::kPromise);
+    claimer.promised(id, answer.other, answer.value);
+  }
+  REQUIRE(claimer.progress() == Progress::kMajority);
+  CHECK(claimer.value() == "h3");
+}
+
 TEST_CASE("a split that first-answer-wins left locked is finished by the next ballot", "[uid_registry]") {
   // Two hosts each got one acceptor to accept itself and the third acceptor was down: no majority.
   std::map<std::string, AcceptorState> acceptors;
@@ -236,13 +298,16 @@ struct Simulation {
     std::optional<BallotTally> tally;
     MessageKind phase = MessageKind::kPrepare;
     std::uint64_t counter = 0;
+    std::string proposal;  // what its phase 2 proposes
   };
 
   std::mt19937 random;
   std::map<std::string, AcceptorState> acceptors;
   std::map<std::string, Proposer> proposers;
+  std::set<std::string> learners;  // proposers that run learn-only rounds (full or draining hosts)
   std::deque<Message> network;
   std::vector<std::string> decided;
+  int unknown = 0;  // learn-only rounds that found no value and proposed nothing
 
   explicit Simulation(unsigned seed) : random(seed) {
     for (const std::string& id : kThree) proposers[id].id = id;
@@ -276,11 +341,22 @@ struct Simulation {
     }
     if (p.tally->progress() != Progress::kMajority) return;
     if (phase1) {
+      p.proposal = p.tally->value();
+      if (learners.count(p.id) != 0) {
+        const auto learned = p.tally->learned_value();
+        if (!learned) {
+          ++unknown;
+          p.counter = std::max(p.counter, p.tally->highest_counter());
+          p.tally.reset();
+          return;
+        }
+        p.proposal = *learned;
+      }
       p.tally->begin_accept();
       p.phase = MessageKind::kAccept;
-      for (const std::string& a : kThree) network.push_back({a, accept("p01", p.ballot, a, p.tally->value())});
+      for (const std::string& a : kThree) network.push_back({a, accept("p01", p.ballot, a, p.proposal)});
     } else {
-      decided.push_back(p.tally->value());
+      decided.push_back(p.proposal);
       p.tally.reset();
     }
   }
@@ -330,6 +406,38 @@ TEST_CASE("duelling proposers on a lossy network never decide two homes, and a q
     if (!sim.decided.empty()) CHECK(*last == sim.decided.front());
   }
   CHECK(runs_with_decisions > 100);  // the chaos decided often enough for the check to mean something
+}
+
+TEST_CASE("learn-only rounds among duelling claims on a lossy network never make their host the home",
+          "[uid_registry]") {
+  int learned_by_learner = 0;
+  int unknown_rounds = 0;
+  for (unsigned seed = 1; seed <= 400; ++seed) {
+    Simulation sim(seed);
+    sim.learners.insert("h1");  // h1 is full: it only learns
+    for (int i = 0; i < 200; ++i) sim.step();
+    CAPTURE(seed);
+    for (const std::string& value : sim.decided) {
+      CHECK(value == sim.decided.front());
+      CHECK(value != "h1");
+    }
+    // With the network quiet, h1 learns what was decided, or finds nothing and proposes nothing.
+    const std::size_t before = sim.decided.size();
+    const auto learned = sim.settle("h1");
+    if (learned) {
+      ++learned_by_learner;
+      CHECK(*learned != "h1");
+      if (before > 0) CHECK(*learned == sim.decided.front());
+    }
+    const auto last = sim.settle(kThree[1 + seed % 2]);
+    REQUIRE(last);
+    CHECK(*last != "h1");
+    if (!sim.decided.empty()) CHECK(*last == sim.decided.front());
+    unknown_rounds += sim.unknown;
+  }
+  // Both ends happened often enough for the checks to mean something.
+  CHECK(learned_by_learner > 100);
+  CHECK(unknown_rounds > 100);
 }
 
 TEST_CASE("the message key binds the secret and the sorted peer list", "[uid_registry]") {
