@@ -27,8 +27,9 @@ packages=(build-essential cmake ninja-build pkg-config git
   ffmpeg)
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)
-# Test-only: Chromium for the browser tests, clang and its runtimes (libFuzzer, sanitizers) for scripts/fuzz.sh.
-[ "$with_browser" = 1 ] && packages+=(chromium clang libclang-rt-14-dev)
+# Test-only: Chromium for the browser tests, clang and its runtimes (libFuzzer, sanitizers) for scripts/fuzz.sh,
+# HAProxy for the cluster tests (scripts/run-cluster-demo.sh; a study installs it on its balancer host).
+[ "$with_browser" = 1 ] && packages+=(chromium clang libclang-rt-14-dev haproxy)
 
 missing=()
 for p in "${packages[@]}"; do
