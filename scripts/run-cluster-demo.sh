@@ -12,7 +12,7 @@
 # scenarios. Per-address rate limits are off (every demo request comes from loopback) unless --rate-limit.
 # The run dir (default BUILD_DIR/cluster-demo) keeps, per host, its data dir hN/, its log hN.log, its pid
 # hN.pid and its argv hN.argv (NUL-separated, for restarting it by hand); and haproxy.cfg, haproxy.log,
-# admin-token and cluster-secret (both mode 0600). Restart a host by hand and write its new pid to hN.pid:
+# admin-token, address-key and cluster-secret (mode 0600). Restart a host by hand and write its new pid to hN.pid:
 # this script still stops it at the end.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -68,8 +68,12 @@ pages="$repo/deploy/haproxy"
 umask 077
 [ -s "$run_dir/cluster-secret" ] || od -An -tx1 -N32 /dev/urandom | tr -d ' \n' > "$run_dir/cluster-secret"
 [ -s "$run_dir/admin-token" ] || od -An -tx1 -N16 /dev/urandom | tr -d ' \n' > "$run_dir/admin-token"
+# One address key for every host, so that a participant's address hashes alike in every host's session data:
+# the study's own RFBSIM_ADDRESS_KEY when set, else one kept in the run dir.
+[ -n "${RFBSIM_ADDRESS_KEY:-}" ] || [ -s "$run_dir/address-key" ] || od -An -tx1 -N32 /dev/urandom | tr -d ' \n' > "$run_dir/address-key"
 umask 022
 admin_token=$(cat "$run_dir/admin-token")
+address_key=${RFBSIM_ADDRESS_KEY:-$(cat "$run_dir/address-key")}
 
 # Whether process PID runs (a zombie, e.g. a host killed by hand and not reaped yet, does not).
 running() {
@@ -129,7 +133,7 @@ start_host() {  # start_host I: host hI in the background; its pid in hI.pid
     --max-unspent-sessions-per-address 0 --max-connections-per-address 0)
   printf '%s\0' "${args[@]}" > "$run_dir/$id.argv"
   mkdir -p "$run_dir/$id"
-  RFBSIM_ADMIN_TOKEN="$admin_token" "${args[@]}" > "$run_dir/$id.log" 2>&1 < /dev/null &
+  RFBSIM_ADMIN_TOKEN="$admin_token" RFBSIM_ADDRESS_KEY="$address_key" "${args[@]}" > "$run_dir/$id.log" 2>&1 < /dev/null &
   echo $! > "$run_dir/$id.pid"
 }
 
