@@ -473,7 +473,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
     };
     const auto answer = std::make_shared<Answer>();  // the reply may come after this function returned
     answer->deferred = deferred;
-    supervisor_.start(request, address, [this, con, answer](const StartOutcome& outcome) {
+    const std::string participant = intake_.participant_address_of(con);
+    supervisor_.start(request, address, participant, [this, con, answer](const StartOutcome& outcome) {
       answer->given = true;
       answer_start(con, outcome);
       if (answer->deferred) {

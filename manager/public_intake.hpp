@@ -84,20 +84,23 @@ class PublicIntake {
   /// The address limits and logs use: the peer, or the participant a trusted front end names; an IPv6
   /// address as its /64 (limit_key).
   std::string client_address_of(const ConnectionPtr& con) {
-    boost::system::error_code ec;
-    const auto remote = con->get_raw_socket().lowest_layer().remote_endpoint(ec);
-    if (ec) return "unknown";
-    return limit_key(
-        client_address(remote.address().to_string(), con->get_request_header("X-Forwarded-For"), trusted_proxies_));
+    const std::string participant = participant_address_of(con);
+    return participant.empty() ? "unknown" : limit_key(participant);
   }
 
-  /// The participant a trusted front end names in X-Forwarded-For (whole, not its /64), for the PROXY line
-  /// the relay sends its session; "" when the peer itself is the participant (or the socket is gone).
+  /// The participant's whole address (not its /64): the peer, or the participant a trusted front end names in
+  /// X-Forwarded-For; its keyed hash goes into the session index. "" when the socket is gone.
+  std::string participant_address_of(const ConnectionPtr& con) {
+    const std::string peer = peer_address_of(con);
+    if (peer.empty()) return "";
+    return client_address(peer, con->get_request_header("X-Forwarded-For"), trusted_proxies_);
+  }
+
+  /// The participant a trusted front end names in X-Forwarded-For, for the PROXY line the relay sends its
+  /// session; "" when the peer itself is the participant (or the socket is gone).
   std::string forwarded_participant_of(const ConnectionPtr& con) {
-    boost::system::error_code ec;
-    const auto remote = con->get_raw_socket().lowest_layer().remote_endpoint(ec);
-    if (ec) return "";
-    const std::string peer = remote.address().to_string();
+    const std::string peer = peer_address_of(con);
+    if (peer.empty()) return "";
     const std::string named = client_address(peer, con->get_request_header("X-Forwarded-For"), trusted_proxies_);
     return named == client_address(peer, "", trusted_proxies_) ? "" : named;
   }
@@ -107,6 +110,13 @@ class PublicIntake {
   std::size_t addresses() const { return limits_.addresses(); }
 
  private:
+  // The socket's peer as text, "" when the socket is gone.
+  static std::string peer_address_of(const ConnectionPtr& con) {
+    boost::system::error_code ec;
+    const auto remote = con->get_raw_socket().lowest_layer().remote_endpoint(ec);
+    return ec ? std::string() : remote.address().to_string();
+  }
+
   void accept_next() {
     if (!running_) return;
     ConnectionPtr con = server_.get_connection();

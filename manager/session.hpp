@@ -95,6 +95,10 @@ struct Session {
   /// The client address /start came from, for the per-address limit on unspent sessions. Kept in memory only:
   /// participants' addresses are not part of the study's record.
   std::string start_address;
+  /// The keyed hash of the participant's whole address that opened /start (the peer, or the participant a
+  /// trusted proxy names; not its /64), as sim_rfb writes it in events.jsonl (record/digest.hpp,
+  /// hash_address); "" when unknown. The index and manager.json keep this, never the address.
+  std::string address_hash;
   /// The participant's stream as sim_rfb last reported it while someone watched; unset before the first report,
   /// when nobody watches, and for sessions read from the index (it is not stored there).
   std::optional<StreamReport> stream;

@@ -40,7 +40,8 @@ CREATE TABLE IF NOT EXISTS sessions (
   data_incomplete TEXT,                 -- why the session's data is incomplete (a full disk...); NULL: complete
   copy_state    TEXT NOT NULL DEFAULT '',  -- after_session_command: '' none, pending, done, failed
   copy_attempts INTEGER NOT NULL DEFAULT 0,  -- tries of that command so far
-  copy_error    TEXT NOT NULL DEFAULT ''   -- its last failure ("exit 23: ..."); '' when done
+  copy_error    TEXT NOT NULL DEFAULT '',  -- its last failure ("exit 23: ..."); '' when done
+  address_hash  TEXT NOT NULL DEFAULT ''   -- keyed hash of the participant's address (as in events.jsonl)
 );
 CREATE INDEX IF NOT EXISTS sessions_by_uid ON sessions (uid, id);
 CREATE INDEX IF NOT EXISTS sessions_by_state ON sessions (state);
@@ -63,7 +64,7 @@ CREATE TABLE IF NOT EXISTS uid_acceptors (
 constexpr const char* kColumns =
     "id, uid, token, scenario, params, seed, host_id, state, detail, exit_status, pid, process_start, port, "
     "data_path, created_at, ready_at, ended_at, outcome, code_success, code_timeout, spent_at, data_incomplete, "
-    "copy_state, copy_attempts, copy_error";
+    "copy_state, copy_attempts, copy_error, address_hash";
 
 // One prepared statement, finalized on scope exit.
 class Statement {
@@ -135,6 +136,7 @@ Session read_row(Statement& row) {
   s.copy_state = row.text(22);
   s.copy_attempts = static_cast<int>(row.integer(23));
   s.copy_error = row.text(24);
+  s.address_hash = row.text(25);
   return s;
 }
 
@@ -203,12 +205,14 @@ void SessionIndex::add_missing_columns() {
   bool has_codes = false;
   bool has_spent = false;
   bool has_copy = false;
+  bool has_address_hash = false;
   {
     Statement columns(db_, "PRAGMA table_info(sessions)");
     while (columns.step()) {
       has_codes = has_codes || columns.text(1) == "code_success";
       has_spent = has_spent || columns.text(1) == "spent_at";
       has_copy = has_copy || columns.text(1) == "copy_state";
+      has_address_hash = has_address_hash || columns.text(1) == "address_hash";
     }
   }
   if (!has_codes) {
@@ -224,6 +228,8 @@ void SessionIndex::add_missing_columns() {
     exec("ALTER TABLE sessions ADD COLUMN copy_attempts INTEGER NOT NULL DEFAULT 0");
     exec("ALTER TABLE sessions ADD COLUMN copy_error TEXT NOT NULL DEFAULT ''");
   }
+  // Sessions recorded before it keep '': their participants' addresses were never hashed.
+  if (!has_address_hash) exec("ALTER TABLE sessions ADD COLUMN address_hash TEXT NOT NULL DEFAULT ''");
 }
 
 void SessionIndex::exec(const char* sql) {
@@ -238,8 +244,8 @@ void SessionIndex::exec(const char* sql) {
 std::int64_t SessionIndex::insert(const Session& s) {
   Statement insert(db_,
                    "INSERT INTO sessions (uid, token, scenario, params, seed, host_id, state, detail, pid, "
-                   "process_start, port, data_path, created_at, code_success, code_timeout, spent_at, id) "
-                   "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
+                   "process_start, port, data_path, created_at, code_success, code_timeout, spent_at, address_hash, "
+                   "id) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
   insert.bind(1, s.uid);
   insert.bind(2, s.token);
   insert.bind(3, s.scenario);
@@ -256,10 +262,11 @@ std::int64_t SessionIndex::insert(const Session& s) {
   insert.bind(14, s.code_success);
   insert.bind(15, s.code_timeout);
   insert.bind(16, s.spent_at);
+  insert.bind(17, s.address_hash);
   if (s.id > 0) {
-    insert.bind(17, s.id);
+    insert.bind(18, s.id);
   } else {
-    insert.bind_null(17);  // SQLite picks the next id
+    insert.bind_null(18);  // SQLite picks the next id
   }
   insert.step();
   return sqlite3_last_insert_rowid(db_);

@@ -72,7 +72,7 @@ std::string session_record_json(const Session& s) {
     return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\"";
   };
   return "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"host\":\"" +
-         json_escape(s.host_id) + "\",\"state\":\"" +
+         json_escape(s.host_id) + "\",\"address_hash\":" + text_or_null(s.address_hash) + ",\"state\":\"" +
          state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"created_at\":\"" + iso_utc(s.created) +
          "\",\"ready_at\":" + time(s.ready_at) + ",\"spent_at\":" + time(s.spent_at) + ",\"ended_at\":" +
          time(s.ended_at) + ",\"outcome\":" + text_or_null(s.outcome) +

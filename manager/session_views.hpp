@@ -33,9 +33,10 @@ std::string status_json(const Session& session, WallTime now, const std::vector<
 std::string session_json(const Session& session, bool include_token);
 
 /// The manager's record of a session, written beside the session's own data as manager.json so that the
-/// study's tools (sim_report) see how each session ended without the index: {"id", "uid", "state", "detail",
-/// "created_at", "ready_at", "spent_at", "ended_at", "outcome", "data_incomplete"} (times ISO 8601 UTC or null;
-/// outcome and data_incomplete null when there is none). No token, address or secret.
+/// study's tools (sim_report) see how each session ended without the index: {"id", "uid", "host",
+/// "address_hash", "state", "detail", "created_at", "ready_at", "spent_at", "ended_at", "outcome",
+/// "data_incomplete"} (times ISO 8601 UTC or null; address_hash, outcome and data_incomplete null when there
+/// is none). address_hash is the participant's address hashed as in events.jsonl. No token, address or secret.
 std::string session_record_json(const Session& session);
 
 }  // namespace rfbsim::manager

@@ -24,6 +24,7 @@
 
 #include "launch_plan.hpp"
 #include "process_launcher.hpp"
+#include "record/digest.hpp"
 #include "session_process.hpp"
 #include "session_views.hpp"
 #include "tokens.hpp"
@@ -48,6 +49,13 @@ std::uint64_t cpu_limit_seconds(const ManagerConfig& config) {
                          static_cast<double>(config.limits.cpu_slack.count()) +
                          static_cast<double>(config.stop_grace.count());
   return static_cast<std::uint64_t>(seconds);
+}
+
+// The key participants' addresses are hashed with: RFBSIM_ADDRESS_KEY, as sim_rfb takes it for events.jsonl,
+// else one drawn for this manager process (hashes then compare within one manager run only).
+const std::string& address_key() {
+  static const std::string key = sim::address_hash_key();
+  return key;
 }
 
 // A free loopback port for a program that must be told its port (kRfb). The port is free when we look;
@@ -227,7 +235,8 @@ int Supervisor::recover_interrupted() {
   return static_cast<int>(left.size());
 }
 
-void Supervisor::start(const StartRequest& request, const std::string& address, StartReply reply) {
+void Supervisor::start(const StartRequest& request, const std::string& address, const std::string& participant,
+                       StartReply reply) {
   StartOutcome outcome;
   Session* live = table_.by_uid(request.uid);
   if (live != nullptr && live->state == SessionState::kEnding) {
@@ -287,6 +296,7 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
   session.code_timeout = request.code_timeout;
   session.host_id = config_.host_id;
   session.start_address = address;
+  session.address_hash = participant.empty() ? std::string() : sim::hash_address(address_key(), participant);
   session.created = std::chrono::system_clock::now();
   // Ids are handed out here, so that the row can be written off this thread; the participant is redirected
   // only once it is committed (below), so a redirect always points at a recorded session.

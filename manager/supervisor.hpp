@@ -64,10 +64,12 @@ class Supervisor {
 
   /// What /start answers with, called on the I/O thread.
   using StartReply = std::function<void(const StartOutcome&)>;
-  /// Admits a valid link from client `address`: back to the uid's live session, or a new one, or why not.
-  /// `reply` is called at once, except for a new session: then once its index row is committed (on the
-  /// writer's thread, posted back), so that a redirect always points at a recorded session.
-  void start(const StartRequest& request, const std::string& address, StartReply reply);
+  /// Admits a valid link from client `address` (the limit key): back to the uid's live session, or a new one,
+  /// or why not. `participant`: the participant's whole address ("" when unknown), of which a new session's
+  /// row records the keyed hash. `reply` is called at once, except for a new session: then once its index row
+  /// is committed (on the writer's thread, posted back), so that a redirect always points at a recorded session.
+  void start(const StartRequest& request, const std::string& address, const std::string& participant,
+             StartReply reply);
 
   /// Whether this host has any session of `uid`, live or ended, in its table, the index or the writes still
   /// queued: such a uid's /start is this host's to answer, without asking the uid registry. Throws

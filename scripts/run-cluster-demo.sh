@@ -179,7 +179,7 @@ write_haproxy_config() {
     echo "    http-check send meth GET uri /healthz ver HTTP/1.1 hdr Host rfbsim-check"
     echo "    http-check expect status 200"
     echo "    default-server inter 1s fall 2 rise 1 weight 100 agent-check agent-inter 1s"
-    echo "    retry-on conn-failure empty-response 503"
+    echo "    retry-on conn-failure empty-response"
     echo "    retries 2"
     echo "    option redispatch 1"
     echo "    http-error status 503 content-type \"text/html; charset=utf-8\" hdr Retry-After 10 hdr Cache-Control no-store" \

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Participants' addresses behind HAProxy: the session's data records the participant's address hash (from the
-// X-Forwarded-For HAProxy adds, which the managers trust), not the balancer's; per-address limits count each
-// participant apart (--rate-limit); and the hosts' data dirs make one report with no duplicate uid.
+// Participants' addresses behind HAProxy: the session's data and the host's session index record the
+// participant's address hash (from the X-Forwarded-For HAProxy adds, which the managers trust), not the
+// balancer's; per-address limits count each participant apart (--rate-limit); and the hosts' data dirs make
+// one report with no duplicate uid.
 #include <catch2/catch.hpp>
+#include <sqlite3.h>
 #include <sys/wait.h>
 
 #include <chrono>
@@ -55,6 +57,23 @@ std::string connect_address(const std::filesystem::path& folder) {
   return "";
 }
 
+// The address_hash column of `uid`'s newest session in a host's index, read with a connection of our own
+// ("?" when there is no such row).
+std::string index_address_hash(const std::filesystem::path& data, const std::string& uid) {
+  sqlite3* db = nullptr;
+  const std::string path = (data / "sessions.db").string();
+  REQUIRE(sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  REQUIRE(sqlite3_prepare_v2(db, "SELECT address_hash FROM sessions WHERE uid = ? ORDER BY id DESC LIMIT 1", -1,
+                             &stmt, nullptr) == SQLITE_OK);
+  sqlite3_bind_text(stmt, 1, uid.c_str(), -1, SQLITE_TRANSIENT);
+  std::string hash = "?";
+  if (sqlite3_step(stmt) == SQLITE_ROW) hash = reinterpret_cast<const char*>(sqlite3_column_text(stmt, 0));
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+  return hash;
+}
+
 // Opens session `started` through `via` (a forwarder to HAProxy) and waits for a few pictures.
 void watch(const StartResult& started, int via) {
   WsRfbBridge bridge("ws://127.0.0.1:" + std::to_string(via) + "/" + started.host + "/s/" + started.token + "/ws");
@@ -85,6 +104,9 @@ TEST_CASE("the participant's address and not the balancer's is hashed and limite
   REQUIRE(rfbsim::test::eventually([&] { return !connect_address(folder).empty(); }, 10s));
   CHECK(connect_address(folder) == rfbsim::sim::hash_address(kAddressKey, "127.0.0.5"));
   CHECK(connect_address(folder) != rfbsim::sim::hash_address(kAddressKey, "127.0.0.1"));
+  // The host's index names the same participant, so that index and events.jsonl can be joined.
+  CHECK(index_address_hash(cluster.host(first.host).data, "addr-1") ==
+        rfbsim::sim::hash_address(kAddressKey, "127.0.0.5"));
 
   // Per-address limits are the participant's: 127.0.0.6 re-opening its link too often is refused (429, the
   // /start burst is 10), while 127.0.0.7 behind the same balancer is not.

@@ -67,9 +67,11 @@ std::string sim_rfb_sessions_yaml() {
 
 int free_cluster_base_port(int hosts) {
   std::mt19937 random(static_cast<unsigned>(::getpid()) ^ static_cast<unsigned>(std::random_device{}()));
-  std::uniform_int_distribution<int> pick(200, 400);  // bases 20000..40000, 100 apart
+  // A cluster uses base..base+303: bases 400 apart never overlap, and 20000..31600 stays below the
+  // ephemeral ports (32768-60999) that clients and pick_free_port draw from.
+  std::uniform_int_distribution<int> pick(50, 79);
   for (int attempt = 0; attempt < 50; ++attempt) {
-    const int base = pick(random) * 100;
+    const int base = pick(random) * 400;
     std::vector<int> wanted{base, base + 300};
     for (int i = 1; i <= hosts; ++i) {
       for (int offset : {0, 100, 200}) wanted.push_back(base + offset + i);
@@ -312,6 +314,11 @@ void ClusterUnderTest::restart_host(const std::string& id) {
   argv.push_back(nullptr);
   const std::string log = (run_dir_ / (id + ".log")).string();
   const std::string token_variable = "RFBSIM_ADMIN_TOKEN=" + admin_token_;
+  // The address key the script gave every host: the study's own when set, else the run dir's.
+  const char* study_key = std::getenv("RFBSIM_ADDRESS_KEY");
+  const std::string key_variable =
+      "RFBSIM_ADDRESS_KEY=" + (study_key != nullptr && *study_key != '\0' ? std::string(study_key)
+                                                                          : read_file(run_dir_ / "address-key"));
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
@@ -321,6 +328,7 @@ void ClusterUnderTest::restart_host(const std::string& id) {
     ::dup2(out, STDOUT_FILENO);
     ::dup2(out, STDERR_FILENO);
     ::putenv(const_cast<char*>(token_variable.c_str()));
+    ::putenv(const_cast<char*>(key_variable.c_str()));
     ::execv(argv[0], argv.data());
     _exit(127);
   }
@@ -335,6 +343,22 @@ void ClusterUnderTest::restart_host(const std::string& id) {
   }
 }
 
-void ClusterUnderTest::reload_haproxy() { ::kill(haproxy_pid_, SIGUSR2); }
+void ClusterUnderTest::reload_haproxy() {
+  // The master logs "Loading success." once per worker it forked; a new one proves the reload happened (a
+  // failed reload leaves the old worker running, which would pass every later check just the same).
+  const auto loads = [&] {
+    const std::string log = read_file(run_dir_ / "haproxy.log");
+    std::size_t count = 0;
+    for (auto at = log.find("Loading success."); at != std::string::npos; at = log.find("Loading success.", at + 1)) {
+      ++count;
+    }
+    return count;
+  };
+  const std::size_t before = loads();
+  ::kill(haproxy_pid_, SIGUSR2);
+  if (!eventually([&] { return loads() > before; }, 10s, 100ms)) {
+    throw std::runtime_error("HAProxy did not reload; its log:\n" + read_file(run_dir_ / "haproxy.log"));
+  }
+}
 
 }  // namespace rfbsim::test

@@ -97,7 +97,8 @@ class ClusterUnderTest {
   /// Starts host `id` again with the argv the script used (its hN.argv), records its pid where the script
   /// looks (hN.pid) and waits until it answers /healthz on its port. Throws when it does not come up.
   void restart_host(const std::string& id);
-  /// SIGUSR2 to HAProxy's master: a reload from the same config (new workers, the old ones finish).
+  /// SIGUSR2 to HAProxy's master: a reload from the same config (new workers, the old ones finish); waits
+  /// until the master logs the new worker's "Loading success.", and throws when it does not.
   void reload_haproxy();
 
  private:

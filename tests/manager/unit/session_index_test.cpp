@@ -323,3 +323,44 @@ TEST_CASE("a row with a state the manager does not know reads as interrupted") {
   REQUIRE(back);
   CHECK(back->state == SessionState::kInterrupted);
 }
+
+TEST_CASE("the participant's address hash is written with the row and kept by updates") {
+  ScratchDir dir;
+  const std::string path = dir.path("sessions.db");
+  SessionIndex index(path);
+  Session s = make("p01");
+  s.address_hash = "0123456789abcdef";
+  s.id = index.insert(s);
+  s.state = SessionState::kRunning;
+  s.address_hash = "ffffffffffffffff";  // not a mutable field: update leaves the row's alone
+  index.update(s);
+  CHECK(sql_text(path, "SELECT address_hash FROM sessions WHERE id = 1") == "0123456789abcdef");
+  const auto back = index.find_by_token(s.token);
+  REQUIRE(back);
+  CHECK(back->address_hash == "0123456789abcdef");
+  // A session whose participant's address is unknown has ''.
+  index.insert(make("p02"));
+  CHECK(sql_text(path, "SELECT address_hash FROM sessions WHERE id = 2").empty());
+}
+
+TEST_CASE("an index made before the address hash gains its column, empty for the sessions it holds") {
+  ScratchDir dir;
+  const std::string path = dir.path("sessions.db");
+  const Session old = make("p01");
+  {
+    SessionIndex index(path);
+    index.insert(old);
+  }
+  // The table as an earlier manager left it: every column but address_hash.
+  sql_text(path, "ALTER TABLE sessions DROP COLUMN address_hash");
+  REQUIRE(sql_text(path, "SELECT COUNT(*) FROM pragma_table_info('sessions') WHERE name = 'address_hash'") == "0");
+  SessionIndex reopened(path);
+  CHECK(sql_text(path, "SELECT COUNT(*) FROM pragma_table_info('sessions') WHERE name = 'address_hash'") == "1");
+  const auto back = reopened.find_by_token(old.token);
+  REQUIRE(back);
+  CHECK(back->address_hash.empty());
+  Session next = make("p02");
+  next.address_hash = "00112233aabbccdd";
+  next.id = reopened.insert(next);
+  CHECK(reopened.find_by_token(next.token)->address_hash == "00112233aabbccdd");
+}

@@ -122,13 +122,16 @@ TEST_CASE("the session record beside the data says how the session ended, with n
   session.created = rfbsim::manager::WallTime{} + std::chrono::seconds(1'700'000'000);
   session.ended_at = session.created + std::chrono::seconds(61);
   CHECK(rfbsim::manager::session_record_json(session) ==
-        "{\"id\":7,\"uid\":\"p\\\"1\",\"host\":\"h2\",\"state\":\"abandoned\",\"detail\":\"no browser connected for 60 s\","
+        "{\"id\":7,\"uid\":\"p\\\"1\",\"host\":\"h2\",\"address_hash\":null,\"state\":\"abandoned\","
+        "\"detail\":\"no browser connected for 60 s\","
         "\"created_at\":\"2023-11-14T22:13:20.000Z\",\"ready_at\":null,\"spent_at\":null,"
         "\"ended_at\":\"2023-11-14T22:14:21.000Z\",\"outcome\":null,\"data_incomplete\":null}\n");
   session.spent_at = session.created + std::chrono::milliseconds(1500);
   session.data_incomplete = "events.jsonl: cannot write (No space left on device)";
+  session.address_hash = "0123456789abcdef";
   const std::string with = rfbsim::manager::session_record_json(session);
   CHECK(with.find("\"spent_at\":\"2023-11-14T22:13:21.500Z\"") != std::string::npos);
   CHECK(with.find("\"data_incomplete\":\"events.jsonl: cannot write (No space left on device)\"") != std::string::npos);
+  CHECK(with.find("\"host\":\"h2\",\"address_hash\":\"0123456789abcdef\",") != std::string::npos);
   CHECK(with.find(session.token) == std::string::npos);
 }
