@@ -402,11 +402,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
           return;
         }
         if (home) {
-          // The balancer routes /<host>/ to that host, which serves the uid from now on.
-          const std::string location = "/" + *home + "/start?" + query;
-          respond_page(con, 303, "<!DOCTYPE html><title>Moved</title><a href=\"" + html_escape(location) +
-                                     "\">Continue</a>\n",
-                       {{"Location", location}});
+          send_to_home(con, *home, query);
         } else {
           // Too few hosts answered: nothing was decided, so the retry (here or elsewhere) is safe.
           metrics_.count_rejection(Rejection::kBusy);
@@ -424,10 +420,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
         if (const auto home = learned_redirect(result, config_.host_id)) {
           // The uid lives on another host (the balancer's pool may land on a full host that is not its home):
           // the participant goes there, as after a claim that another host won.
-          const std::string location = "/" + *home + "/start?" + query;
-          respond_page(con, 303, "<!DOCTYPE html><title>Moved</title><a href=\"" + html_escape(location) +
-                                     "\">Continue</a>\n",
-                       {{"Location", location}});
+          send_to_home(con, *home, query);
         } else {
           // No home yet, this host's own (claimed, never started, and no room now), or nothing learned: busy,
           // as before. This round proposed nothing of its own, so trying another host is safe.
@@ -486,6 +479,14 @@ class FrontendImpl final : public Frontend, public SessionListener {
       answer->deferred = true;
       con->defer_http_response();
     }
+  }
+
+  // 303 to the uid's home host's /start with the same query: the balancer routes /<host>/ to that host, which
+  // serves the uid from now on.
+  void send_to_home(const ConnectionPtr& con, const std::string& home, const std::string& query) {
+    const std::string location = "/" + home + "/start?" + query;
+    respond_page(con, 303, "<!DOCTYPE html><title>Moved</title><a href=\"" + html_escape(location) + "\">Continue</a>\n",
+                 {{"Location", location}});
   }
 
   void answer_start(const ConnectionPtr& con, const StartOutcome& outcome) {

@@ -14,6 +14,7 @@
 #include "report_job.hpp"
 #include "session_catalog.hpp"
 #include "session_files.hpp"
+#include "sim_report_runner.hpp"
 
 using namespace rfbsim::report;
 using namespace rfbsim::report::test;
@@ -40,17 +41,6 @@ const std::map<std::string, std::string>& row_with(const std::vector<std::map<st
   REQUIRE(it != rows.end());
   return *it;
 }
-
-int sim_report(const ScratchDir& scratch, const std::string& args) {
-  const std::string command = std::string("'") + SIM_REPORT_BINARY + "' " + args + " >'" +
-                              (scratch.path() / "stdout.txt").string() + "' 2>'" +
-                              (scratch.path() / "stderr.txt").string() + "'";
-  const int status = std::system(command.c_str());
-  REQUIRE(WIFEXITED(status));
-  return WEXITSTATUS(status);
-}
-
-std::string quoted(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
 
 }  // namespace
 

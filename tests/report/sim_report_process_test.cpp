@@ -3,30 +3,12 @@
 // parsing to the right rows, manager.json's warnings and left-out sessions on stderr, and the usage errors.
 #include <catch2/catch.hpp>
 
-#include <sys/wait.h>
-
-#include <cstdlib>
 #include <string>
 
 #include "session_files.hpp"
+#include "sim_report_runner.hpp"
 
 using namespace rfbsim::report::test;
-
-namespace {
-
-// Runs sim_report with `args` (already quoted), stdout and stderr to files in `scratch`; its exit status.
-int sim_report(const ScratchDir& scratch, const std::string& args) {
-  const std::string command = std::string("'") + SIM_REPORT_BINARY + "' " + args + " >'" +
-                              (scratch.path() / "stdout.txt").string() + "' 2>'" +
-                              (scratch.path() / "stderr.txt").string() + "'";
-  const int status = std::system(command.c_str());
-  REQUIRE(WIFEXITED(status));
-  return WEXITSTATUS(status);
-}
-
-std::string quoted(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
-
-}  // namespace
 
 TEST_CASE("sim_report writes the four files for a data folder and sessions.csv has a row per session") {
   ScratchDir scratch;
