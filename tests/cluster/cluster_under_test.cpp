@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -92,7 +93,34 @@ std::pair<std::string, std::string> session_of_location(const std::string& locat
   return {match[1], match[2]};
 }
 
+namespace {
+
+// The script exited before `cluster ready`: usually a port seen free was taken before a host bound it (a
+// client's ephemeral port, another test's cluster), so the constructor tries again on another base.
+struct ScriptExitedEarly : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace
+
 ClusterUnderTest::ClusterUnderTest(const ClusterOptions& options) {
+  constexpr int kTries = 3;
+  for (int attempt = 1;; ++attempt) {
+    try {
+      launch(options);
+      return;
+    } catch (const ScriptExitedEarly& error) {
+      if (attempt == kTries) throw;
+      std::fprintf(stderr, "cluster: try %d of %d failed, another base port next:\n%s\n", attempt, kTries, error.what());
+      std::error_code ignored;
+      std::filesystem::remove_all(run_dir_, ignored);
+      hosts_.clear();
+      haproxy_pid_ = -1;
+    }
+  }
+}
+
+void ClusterUnderTest::launch(const ClusterOptions& options) {
   port_ = free_cluster_base_port(options.hosts);
   stats_port_ = port_ + 300;
   run_dir_ = std::filesystem::temp_directory_path() /
@@ -146,7 +174,7 @@ ClusterUnderTest::ClusterUnderTest(const ClusterOptions& options) {
     const ssize_t n = ::read(output_fd_, buffer, sizeof buffer);
     if (n <= 0) {
       stop();
-      throw std::runtime_error("run-cluster-demo.sh exited before it was ready; it printed:\n" + output);
+      throw ScriptExitedEarly("run-cluster-demo.sh exited before it was ready; it printed:\n" + output);
     }
     output.append(buffer, static_cast<std::size_t>(n));
   }

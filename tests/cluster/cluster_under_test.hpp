@@ -102,6 +102,10 @@ class ClusterUnderTest {
   void reload_haproxy();
 
  private:
+  /// One try at starting the cluster on a fresh base port; throws ScriptExitedEarly when the script gave up
+  /// before it was ready (a port seen free was taken meanwhile), anything else on other failures.
+  void launch(const ClusterOptions& options);
+
   int port_ = 0;
   int stats_port_ = 0;
   pid_t script_pid_ = -1;
