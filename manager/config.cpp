@@ -584,6 +584,16 @@ std::string cluster_problem(const ManagerConfig& config) {
   const auto self = std::find_if(config.cluster_peers.begin(), config.cluster_peers.end(),
                                  [&](const ClusterPeer& peer) { return peer.id == config.host_id; });
   if (self == config.cluster_peers.end()) return "host_id '" + config.host_id + "' is not one of cluster_peers";
+  // A registry answer sends a participant to /<home>/start on the balancer's one origin: every host must own
+  // /<its id> there.
+  if (config.path_prefix != "/" + config.host_id) {
+    return "with cluster_peers, path_prefix must be /" + config.host_id +
+           " (other hosts send this host's participants to /<host_id>/start), not '" + config.path_prefix + "'";
+  }
+  if (!config.public_url.empty()) {
+    return "cluster_peers needs the balancer's one origin: leave public_url empty (the registry's redirects are "
+           "relative to it)";
+  }
   if (config.registry_port != 0 && config.registry_port != self->port) {
     return "registry_port " + std::to_string(config.registry_port) + " differs from this host's cluster_peers entry (" +
            std::to_string(self->port) + ")";

@@ -395,8 +395,10 @@ class FrontendImpl final : public Frontend, public SessionListener {
     }
     if (claim == Claim::kYes) {
       con->defer_http_response();
+      ++claims_in_flight_;
       registry_->claim(parsed.request->uid, [this, con, request = *parsed.request, address,
                                              query = route.query](const std::optional<std::string>& home) {
+        --claims_in_flight_;
         if (home && *home == config_.host_id) {
           start_session(con, request, address, true);
           return;
@@ -453,8 +455,12 @@ class FrontendImpl final : public Frontend, public SessionListener {
       return Claim::kUnknown;
     }
     if (supervisor_.shutting_down()) return Claim::kNo;
-    return supervisor_.table().full() || supervisor_.draining() ? Claim::kLearn : Claim::kYes;
+    // Claims still deciding hold a slot each: two new uids must not both win this host's last slot, or the
+    // loser would be homed here for good while other hosts have room.
+    const bool full = static_cast<int>(supervisor_.table().size()) + claims_in_flight_ >= config_.max_sessions;
+    return full || supervisor_.draining() ? Claim::kLearn : Claim::kYes;
   }
+  int claims_in_flight_ = 0;  // claim rounds started by /start here and not yet decided (I/O thread only)
 
   // Admits `request` on this host; `deferred`: the response was deferred already (after a claim round).
   void start_session(const ConnectionPtr& con, const StartRequest& request, const std::string& address,

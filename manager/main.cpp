@@ -14,6 +14,7 @@
 #include <boost/asio/steady_timer.hpp>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include "agent_check.hpp"
@@ -26,6 +27,7 @@
 #include "session_index.hpp"
 #include "start_request.hpp"
 #include "supervisor.hpp"
+#include "tokens.hpp"
 #include "uid_registry.hpp"
 
 extern char** environ;
@@ -283,6 +285,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "sim_manager: --sign: %s\n", error.what());
       return 2;
     }
+  }
+  // One address key for the index and every session's events.jsonl: the study's RFBSIM_ADDRESS_KEY, else one
+  // drawn now (before any thread) and handed to the sessions through the environment they inherit.
+  if (const char* key = std::getenv("RFBSIM_ADDRESS_KEY"); key == nullptr || *key == '\0') {
+    ::setenv("RFBSIM_ADDRESS_KEY", (manager::new_session_token() + manager::new_session_token()).c_str(), 1);
   }
   try {
     return run(std::move(parsed.config));

@@ -51,8 +51,8 @@ std::uint64_t cpu_limit_seconds(const ManagerConfig& config) {
   return static_cast<std::uint64_t>(seconds);
 }
 
-// The key participants' addresses are hashed with: RFBSIM_ADDRESS_KEY, as sim_rfb takes it for events.jsonl,
-// else one drawn for this manager process (hashes then compare within one manager run only).
+// The key participants' addresses are hashed with: RFBSIM_ADDRESS_KEY, which main() sets when the study did
+// not, so that the sessions (which inherit it) hash alike in events.jsonl.
 const std::string& address_key() {
   static const std::string key = sim::address_hash_key();
   return key;

@@ -516,3 +516,47 @@ TEST_CASE("duelling proposers: many fresh uids started at once on every host get
     }
   }
 }
+
+TEST_CASE("two new uids racing for a host's last slot: the one left out is homed nowhere, and starts elsewhere",
+          "[manager][registry]") {
+  Cluster cluster(3, 1);  // one slot each
+  for (int round = 0; round < 4; ++round) {
+    const std::string first = "reg-slot-a" + std::to_string(round), second = "reg-slot-b" + std::to_string(round);
+    std::atomic<int> ready{0};
+    std::vector<net::HttpResponse> responses(2);
+    std::vector<std::thread> threads;
+    for (int k = 0; k < 2; ++k) {
+      threads.emplace_back([&, k] {
+        ++ready;
+        while (ready.load() < 2) std::this_thread::yield();
+        responses[static_cast<std::size_t>(k)] =
+            cluster.host(0).start("uid=" + (k == 0 ? first : second) + "&scenario=demo");
+      });
+    }
+    for (auto& thread : threads) thread.join();
+    // One of them has h1's slot; the other was never homed on h1 (a claim in flight holds the slot it would
+    // take), so it got the busy page and no host accepted a home for it.
+    const int winner = responses[0].status == 302 ? 0 : 1;
+    const std::string left_out = winner == 0 ? second : first;
+    CAPTURE(round, responses[0].status, responses[1].status);
+    REQUIRE(responses[static_cast<std::size_t>(winner)].status == 302);
+    CHECK(responses[static_cast<std::size_t>(1 - winner)].status == 503);
+    for (int i = 0; i < 3; ++i) CHECK(cluster.accepted_value(i, left_out).empty());
+    // Where there is room it starts, as the balancer would send it there next.
+    const int elsewhere = 1 + round % 2;
+    CHECK(token_of(cluster.host(elsewhere).start("uid=" + left_out + "&scenario=demo"), Cluster::id(elsewhere))
+              .size() == 32);
+    // Free every slot for the next round.
+    for (int i = 0; i < 3; ++i) {
+      for (const auto& row : cluster.host(i).index_rows()) {
+        if (row.state == "running" || row.state == "starting") cluster.host(i).end_session(row.id, kAdminToken);
+      }
+    }
+    const auto bearer = std::string("Bearer ") + kAdminToken;
+    for (int i = 0; i < 3; ++i) {
+      REQUIRE(rfbsim::test::eventually(
+          [&] { return cluster.host(i).get("/api/host", {{"Authorization", bearer}}).body.find("\"live\":0") != std::string::npos; },
+          20s));
+    }
+  }
+}
