@@ -345,7 +345,10 @@ class FrontendImpl final : public Frontend, public SessionListener {
   }
 
   void handle_start(const ConnectionPtr& con, const Route& route) {
-    const std::string address = intake_.client_address_of(con);
+    // Read while the browser is surely there: after a claim round it may have left. The whole address is
+    // hashed into the index; its abuse key (an IPv6 address's /64) counts in the limits.
+    const std::string participant = intake_.participant_address_of(con);
+    const std::string address = PublicIntake<Server>::abuse_key(participant);
     const auto decision = start_limiter_.take(address, std::chrono::steady_clock::now());
     if (!decision.allowed) {
       metrics_.count_rejection(Rejection::kRateLimited);
@@ -396,11 +399,11 @@ class FrontendImpl final : public Frontend, public SessionListener {
     if (claim == Claim::kYes) {
       con->defer_http_response();
       ++claims_in_flight_;
-      registry_->claim(parsed.request->uid, [this, con, request = *parsed.request, address,
+      registry_->claim(parsed.request->uid, [this, con, request = *parsed.request, address, participant,
                                              query = route.query](const std::optional<std::string>& home) {
         --claims_in_flight_;
         if (home && *home == config_.host_id) {
-          start_session(con, request, address, true);
+          start_session(con, request, address, participant, true);
           return;
         }
         if (home) {
@@ -434,7 +437,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
       });
       return;
     }
-    start_session(con, *parsed.request, address, false);
+    start_session(con, *parsed.request, address, participant, false);
   }
 
   // Whether /start of `uid` must ask the uid registry first.
@@ -462,9 +465,10 @@ class FrontendImpl final : public Frontend, public SessionListener {
   }
   int claims_in_flight_ = 0;  // claim rounds started by /start here and not yet decided (I/O thread only)
 
-  // Admits `request` on this host; `deferred`: the response was deferred already (after a claim round).
+  // Admits `request` on this host, from `participant` (whole) counted as `address` (its abuse key);
+  // `deferred`: the response was deferred already (after a claim round).
   void start_session(const ConnectionPtr& con, const StartRequest& request, const std::string& address,
-                     bool deferred) {
+                     const std::string& participant, bool deferred) {
     // A new session's answer waits for its index row, which is written off this thread: defer the response.
     struct Answer {
       bool given = false;
@@ -472,7 +476,6 @@ class FrontendImpl final : public Frontend, public SessionListener {
     };
     const auto answer = std::make_shared<Answer>();  // the reply may come after this function returned
     answer->deferred = deferred;
-    const std::string participant = intake_.participant_address_of(con);
     supervisor_.start(request, address, participant, [this, con, answer](const StartOutcome& outcome) {
       answer->given = true;
       answer_start(con, outcome);

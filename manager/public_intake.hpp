@@ -83,8 +83,10 @@ class PublicIntake {
 
   /// The address limits and logs use: the peer, or the participant a trusted front end names; an IPv6
   /// address as its /64 (limit_key).
-  std::string client_address_of(const ConnectionPtr& con) {
-    const std::string participant = participant_address_of(con);
+  std::string client_address_of(const ConnectionPtr& con) { return abuse_key(participant_address_of(con)); }
+
+  /// The key a participant's whole address (participant_address_of) counts under in the abuse limits.
+  static std::string abuse_key(const std::string& participant) {
     return participant.empty() ? "unknown" : limit_key(participant);
   }
 
