@@ -421,14 +421,20 @@ class FrontendImpl final : public Frontend, public SessionListener {
     }
     if (claim == Claim::kLearn) {
       con->defer_http_response();
-      registry_->learn(parsed.request->uid, [this, con, query = route.query](const LearnResult& result) {
+      registry_->learn(parsed.request->uid, [this, con, request = *parsed.request, address, participant,
+                                             query = route.query](const LearnResult& result) {
         if (const auto home = learned_redirect(result, config_.host_id)) {
           // The uid lives on another host (the balancer's pool may land on a full host that is not its home):
           // the participant goes there, as after a claim that another host won.
           send_to_home(con, *home, query);
+        } else if (result.kind == LearnKind::kDecided && result.home == config_.host_id) {
+          // Its home is this host: the supervisor admits it if a slot is really free (the host may only have
+          // looked full for the claims in flight), joins its session if one started meanwhile, else says busy.
+          start_session(con, request, address, participant, true);
+          return;
         } else {
-          // No home yet, this host's own (claimed, never started, and no room now), or nothing learned: busy,
-          // as before. This round proposed nothing of its own, so trying another host is safe.
+          // No home yet, or nothing learned: busy, as before. This round proposed nothing of its own, so trying
+          // another host is safe.
           metrics_.count_rejection(Rejection::kBusy);
           respond_page(con, 503, busy_page(kBusyRetrySeconds), {{"Retry-After", std::to_string(kBusyRetrySeconds)}});
         }
