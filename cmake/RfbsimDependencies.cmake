@@ -13,6 +13,8 @@ find_package(Boost REQUIRED COMPONENTS system)       # websocketpp's asio transp
 find_package(OpenSSL 3 REQUIRED)                     # OpenSSL::SSL, OpenSSL::Crypto: TLS, signed links, tokens
 find_package(SQLite3 REQUIRED)                       # SQLite::SQLite3: sim_manager's session index
 find_package(nlohmann_json 3 REQUIRED CONFIG)        # nlohmann_json::nlohmann_json: session data (record/, tools/)
+pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)  # PkgConfig::ZSTD: session.mcap's chunks (simulator/ros/mcap)
+find_package(ZLIB REQUIRED)                          # ZLIB::ZLIB: crc32 for session.mcap's CRCs
 find_package(Freetype REQUIRED)                      # Freetype::Freetype: the HUD's text (render/)
 # libavcodec/-format/-util and libswscale: sim_replay's H.264 video (FFmpeg has no CMake config)
 pkg_check_modules(LIBAV REQUIRED IMPORTED_TARGET libavcodec libavformat libavutil libswscale)

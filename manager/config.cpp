@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "client_address.hpp"
 #include "copy_command.hpp"
 #include "launch_plan.hpp"
+#include "ros_settings.hpp"
 #include "routes.hpp"
 #include "start_request.hpp"
 #include "uid_registry.hpp"
@@ -322,6 +324,49 @@ const std::map<std::string, Setting>& settings() {
        }}},
       {"after_session_retries", {false, integer(&ManagerConfig::after_session_retries, 0, 100)}},
       {"after_session_timeout_s", {false, seconds(&ManagerConfig::after_session_timeout, 1)}},
+      // The ros: section, each key as ros_<key> (--ros-<key> on the command line); files made absolute, since a
+      // session runs in its own folder.
+      {"ros_connect", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (std::string problem = rosbridge_url_problem(v.front()); !problem.empty()) return problem;
+         c.ros.connect = v.front();
+         return "";
+       }}},
+      {"ros_token_file", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.front().empty()) return "must not be empty";
+         std::error_code ec;
+         const std::string path = std::filesystem::absolute(v.front(), ec).string();
+         if (ec) return "cannot make " + v.front() + " absolute: " + ec.message();
+         if (std::string problem = token_file_problem(path); !problem.empty()) return problem;
+         c.ros.token_file = path;
+         return "";
+       }}},
+      {"ros_ca_file", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.front().empty()) return "must not be empty";
+         std::error_code ec;
+         const std::string path = std::filesystem::absolute(v.front(), ec).string();
+         if (ec) return "cannot make " + v.front() + " absolute: " + ec.message();
+         if (std::string problem = ca_file_problem(path); !problem.empty()) return problem;
+         c.ros.ca_file = path;
+         return "";
+       }}},
+      {"ros_namespace", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (!is_ros_name(v.front())) {
+           return "expected a ROS name such as /rfbsim: '/', then segments of letters, digits and '_' that start "
+                  "with a letter, joined by '/', no '/' at the end";
+         }
+         c.ros.ros_namespace = v.front();
+         return "";
+       }}},
+      {"ros_robot_control", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.front() != "builtin" && v.front() != "external") return "expected builtin or external";
+         c.ros.robot_control = v.front();
+         return "";
+       }}},
+      {"ros_cmd_vel_type", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.front() != "twist" && v.front() != "twist_stamped") return "expected twist or twist_stamped";
+         c.ros.cmd_vel_type = v.front();
+         return "";
+       }}},
       {"limit_cpu_slack_s", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          long long value = 0;
          if (!parse_integer(v.front(), 0LL, 86400LL, value)) return "expected whole seconds 0..86400";
@@ -422,6 +467,12 @@ std::string manager_usage() {
          "  --cluster-secret-file F the hosts' shared registry secret, 16+ bytes (mode 0600)\n"
          "  --registry-port N       this host's registry port (default: its cluster-peers entry's)\n"
          "  --registry-bind ADDR    the registry's numeric IPv4 address (default: listen-address)\n"
+         "  --ros-connect URL       ws:// or wss:// rosbridge_server of a lab: each session of a scenario with a\n"
+         "                          robot dials out to it (the ros: section of the file; default: no ROS)\n"
+         "  --ros-token-file F, --ros-ca-file F   a Bearer token and extra CA certificates for that dial-out\n"
+         "  --ros-namespace NS      each session's topics under NS/s_<id> (default /rfbsim)\n"
+         "  --ros-robot-control builtin|external  who drives the robot where a link does not say (default builtin)\n"
+         "  --ros-cmd-vel-type twist|twist_stamped  the type of the lab's /cmd_vel (default twist)\n"
          "  --sign QUERY            print QUERY with its link signature (needs a link secret) and exit\n";
 }
 
@@ -443,25 +494,21 @@ ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
     outcome.error = path + ": expected a mapping of settings (key: value)";
     return outcome;
   }
-  for (const auto& item : root) {
-    if (!item.first.IsScalar()) {
-      outcome.error = path + ":" + std::to_string(item.first.Mark().line + 1) + ": expected a setting name as key";
-      return outcome;
-    }
-    const std::string key = item.first.Scalar();
-    const std::string where = path + ":" + std::to_string(item.first.Mark().line + 1) + ": " + key + ": ";
+  // One setting from its YAML node: `key` names it in the table, `shown` in messages ("ros.connect").
+  const auto apply = [&](const std::string& key, const std::string& shown, const YAML::Node& name,
+                         const YAML::Node& node) -> bool {
+    const std::string where = path + ":" + std::to_string(name.Mark().line + 1) + ": " + shown + ": ";
     const auto setting = settings().find(key);
     if (setting == settings().end()) {
       outcome.error = where + "unknown setting";
-      return outcome;
+      return false;
     }
     std::vector<std::string> values;
-    const YAML::Node& node = item.second;
     if (setting->second.list && node.IsSequence()) {
       for (const auto& element : node) {
         if (!element.IsScalar()) {
           outcome.error = where + "expected a list of plain values";
-          return outcome;
+          return false;
         }
         values.push_back(element.Scalar());
       }
@@ -470,13 +517,52 @@ ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
       if (setting->second.list) values = split_commas(node.Scalar());
     } else {
       outcome.error = where + (setting->second.list ? "expected a list" : "expected a single value");
-      return outcome;
+      return false;
     }
     if (!setting->second.list && values.empty()) values.emplace_back();
     const std::string problem = setting->second.apply(outcome.config, values);
     if (!problem.empty()) {
       outcome.error = where + problem;
+      return false;
+    }
+    return true;
+  };
+  for (const auto& item : root) {
+    if (!item.first.IsScalar()) {
+      outcome.error = path + ":" + std::to_string(item.first.Mark().line + 1) + ": expected a setting name as key";
       return outcome;
+    }
+    const std::string key = item.first.Scalar();
+    const std::string line = path + ":" + std::to_string(item.first.Mark().line + 1) + ": ";
+    // The ros section is a mapping of its own (ros: {connect: ...}); its keys are the table's ros_<key>, which
+    // the file names only that way, so that one setting has one spelling there.
+    if (key.rfind("ros_", 0) == 0) {
+      outcome.error = line + key + ": unknown setting (write it as " + key.substr(4) + ": under ros:)";
+      return outcome;
+    }
+    if (key != "ros") {
+      if (!apply(key, key, item.first, item.second)) return outcome;
+      continue;
+    }
+    if (!item.second.IsMap()) {
+      outcome.error = line + "ros: expected a mapping (connect, token_file, ca_file, namespace, robot_control, cmd_vel_type)";
+      return outcome;
+    }
+    for (const auto& sub : item.second) {
+      if (!sub.first.IsScalar()) {
+        outcome.error = path + ":" + std::to_string(sub.first.Mark().line + 1) + ": ros: expected a setting name as key";
+        return outcome;
+      }
+      const std::string name = sub.first.Scalar();
+      static const char* const kRosKeys[] = {"connect", "token_file", "ca_file", "namespace", "robot_control",
+                                             "cmd_vel_type"};
+      const bool known = std::find(std::begin(kRosKeys), std::end(kRosKeys), name) != std::end(kRosKeys);
+      if (!known) {
+        outcome.error = path + ":" + std::to_string(sub.first.Mark().line + 1) + ": ros." + name +
+                        ": unknown setting (known: connect, token_file, ca_file, namespace, robot_control, cmd_vel_type)";
+        return outcome;
+      }
+      if (!apply("ros_" + name, "ros." + name, sub.first, sub.second)) return outcome;
     }
   }
   return outcome;
@@ -601,6 +687,30 @@ std::string cluster_problem(const ManagerConfig& config) {
   return "";
 }
 
+// The ros section's settings fit together and with the sessions it applies to.
+std::string ros_problem(const ManagerConfig& config) {
+  const RosSettings& ros = config.ros;
+  if (ros.connect.empty()) {
+    if (!ros.token_file.empty() || !ros.ca_file.empty()) return "ros: token_file and ca_file need connect";
+    // Nothing else can drive an externally controlled robot: sim_manager never opens sim_rfb's own port.
+    if (ros.robot_control == "external") return "ros: robot_control external needs connect (the lab's rosbridge)";
+    return "";
+  }
+  if (config.session_kind != SessionKind::kSimRfb) {
+    return "ros: needs session_kind sim_rfb (a legacy program's template may use {robot_control} itself)";
+  }
+  const bool tls = ros.connect.rfind("wss://", 0) == 0;
+  if (!ros.ca_file.empty() && !tls) return "ros: ca_file needs a wss:// connect";
+  if (!ros.token_file.empty() && !tls) {
+    // A Bearer token over plain ws:// is readable by anyone on the path; only loopback is spared that.
+    const std::string_view rest = std::string_view(ros.connect).substr(5);
+    const std::string_view host = rest.substr(0, rest.find_first_of(":/?#"));
+    const bool loopback = host == "127.0.0.1" || host == "localhost" || rest.rfind("[::1]", 0) == 0;
+    if (!loopback) return "ros: token_file needs a wss:// connect: over ws:// the token would cross the network in clear";
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string validate_config(const ManagerConfig& config) {
@@ -621,6 +731,7 @@ std::string validate_config(const ManagerConfig& config) {
     return problem;
   }
   if (std::string problem = copy_command_problem(config.after_session_command); !problem.empty()) return problem;
+  if (std::string problem = ros_problem(config); !problem.empty()) return problem;
   return "";
 }
 

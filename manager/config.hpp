@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "ros_settings.hpp"
 #include "start_request.hpp"
 
 namespace rfbsim::manager {
@@ -17,7 +18,7 @@ enum class SessionKind {
   kSimRfb,  ///< sim_rfb: the manager adds --port 0 --rfb-only --ready-fd 3, --codec and the link's parameters
   kRfb,     ///< any program serving raw RFB on a loopback port: args may use {port} {scenario} {seed} {uid}
             ///< {data_dir} {t1} {t2} and the overrides' {avatar_start} {avatar_goal} {robot_start}
-            ///< {robot_goal} {crowd} (session_arguments); ready once the port accepts a connection
+            ///< {robot_goal} {crowd} {robot_control} (session_arguments); ready once the port accepts a connection
 };
 
 /// The default RLIMIT_AS of sessions, MiB. AddressSanitizer builds (scripts/test.sh --sanitize) reserve
@@ -133,6 +134,8 @@ struct ManagerConfig {
   std::string cluster_secret_file;  ///< the hosts' shared registry secret (>= 16 bytes); needed with peers
   int registry_port = 0;            ///< this host's registry port; 0 = its own cluster_peers entry's
   std::string registry_bind;        ///< the registry's numeric IPv4 address; empty = listen_address
+  /// The `ros:` section: sessions of scenarios with a robot dial out to a lab's rosbridge_server (kSimRfb only).
+  RosSettings ros;
 };
 
 /// The outcome of reading settings: a config, or a message naming the file, line or flag at fault.

@@ -13,6 +13,7 @@
 #include <websocketpp/config/asio.hpp>
 #include <websocketpp/server.hpp>
 
+#include "launch_plan.hpp"
 #include "link_signature.hpp"
 #include "pages.hpp"
 #include "proxy_line.hpp"
@@ -371,6 +372,10 @@ class FrontendImpl final : public Frontend, public SessionListener {
     const StartParse parsed = parse_start_request(*params, scenario_names(config_.scenarios), config_.scenario_facts);
     if (!parsed.request) {
       refuse(con, 400, Rejection::kBadRequest, "This link is not valid", parsed.error);
+      return;
+    }
+    if (const std::string problem = ros_request_problem(config_, *parsed.request); !problem.empty()) {
+      refuse(con, 400, Rejection::kBadRequest, "This link is not valid", problem);
       return;
     }
     // A link published in the open can be given an end: exp, a Unix time, signed with the rest.

@@ -36,16 +36,32 @@ std::string expand(const std::string& text, const std::vector<std::pair<std::str
 // --seed, --codec) are what the index says of the session. None may come from anywhere but the manager.
 // --allow-origin is not the manager's, but would only open a session to pages other than through the
 // relay, which checks the Origin itself.
-const std::vector<std::string> kManagerFlags = {"--bind",     "--port",     "--unix-socket", "--ready-fd",
-                                                "--rfb-only", "--web-root", "--proxy-protocol",
-                                                "--data-dir", "--uid",      "--scenario",    "--seed",
-                                                "--codec",    "--allow-origin"};
+// ROS's flags are the ros section's and the link's; --rosbridge-port and --rosbridge-bind would open sim_rfb's
+// rosbridge server, which has no authentication: any local user or participant who reached it could drive the
+// robot or read the session, so the manager never opens it.
+const std::vector<std::string> kManagerFlags = {
+    "--bind", "--port", "--unix-socket", "--ready-fd", "--rfb-only", "--web-root", "--proxy-protocol", "--data-dir",
+    "--uid", "--scenario", "--seed", "--codec", "--allow-origin",
+    // ROS (issue 20)
+    "--robot-control", "--rosbridge-connect", "--rosbridge-token-file", "--rosbridge-ca", "--ros-namespace",
+    "--rosbridge-port", "--rosbridge-bind", "--cmd-vel-type"};
 
 std::string session_args_problem(const std::vector<std::string>& session_args, SessionKind kind) {
   if (kind != SessionKind::kSimRfb) return "";
   for (const std::string& arg : session_args) {
     const std::string flag = arg.substr(0, arg.find('='));
     if (std::find(kManagerFlags.begin(), kManagerFlags.end(), flag) == kManagerFlags.end()) continue;
+    if (flag == "--rosbridge-port" || flag == "--rosbridge-bind") {
+      return "session_args: " + flag + " cannot be given there: sim_rfb's rosbridge server has no authentication, "
+             "so any local user could drive the robot (use ros.connect: each session dials out to the lab)";
+    }
+    if (flag == "--robot-control") {
+      return "session_args: --robot-control is set by sim_manager from the link's robot_control or ros.robot_control "
+             "and cannot be given there";
+    }
+    if (flag.rfind("--ros", 0) == 0) {
+      return "session_args: " + flag + " is set by sim_manager from the ros section and cannot be given there";
+    }
     if (flag == "--allow-origin") {
       return "session_args: --allow-origin cannot be given there: sessions are reached only through sim_manager's "
              "relay, which checks the Origin itself (see frame_origins)";
@@ -58,6 +74,43 @@ std::string session_args_problem(const std::vector<std::string>& session_args, S
     return "session_args: " + flag + " is set by sim_manager for every session and cannot be given there" + where;
   }
   return "";
+}
+
+SessionRos session_ros(const ManagerConfig& config, const StartRequest& request, std::int64_t session_id) {
+  SessionRos ros;
+  const auto asked = std::find_if(request.overrides.begin(), request.overrides.end(),
+                                  [](const auto& override_) { return override_.first == "robot_control"; });
+  if (asked != request.overrides.end()) ros.robot_control = asked->second;
+  // A legacy program gets the link's value as {robot_control}, and what it does with it is its own.
+  if (config.session_kind != SessionKind::kSimRfb) return ros;
+  const auto facts = std::find_if(config.scenario_facts.begin(), config.scenario_facts.end(),
+                                  [&request](const ScenarioFacts& f) { return f.name == request.scenario; });
+  // Only a scenario known to have a robot: without one there is nothing to drive, and a scenario whose file
+  // the manager did not find is left as it was.
+  if (facts == config.scenario_facts.end() || !facts->has_robot) return ros;
+  const bool dials_out = !config.ros.connect.empty();
+  if (ros.robot_control.empty()) ros.robot_control = dials_out ? config.ros.robot_control : "builtin";
+  if (dials_out) {
+    // Hosts of a cluster number their sessions each from 1, and may share one lab: their names carry the host.
+    const std::string host = config.cluster_peers.empty() ? std::string() : config.host_id;
+    ros.ros_namespace = config.ros.ros_namespace + "/" + ros_session_name(session_id, host);
+  }
+  return ros;
+}
+
+std::string ros_request_problem(const ManagerConfig& config, const StartRequest& request) {
+  if (config.session_kind != SessionKind::kSimRfb) return "";
+  const SessionRos ros = session_ros(config, request, 0);
+  const bool asked = std::any_of(request.overrides.begin(), request.overrides.end(), [](const auto& override_) {
+    return override_.first == "robot_control" && override_.second == "external";
+  });
+  if (!asked || !ros.ros_namespace.empty()) return "";
+  if (config.ros.connect.empty()) {
+    return "robot_control external is not offered here: this server has no connection to a lab's ROS (ros.connect), "
+           "so nothing would drive the robot";
+  }
+  return "robot_control external is not offered for scenario " + request.scenario +
+         ": sim_manager did not find its file, so it cannot tell whether it has a robot";
 }
 
 std::vector<std::string> session_arguments(const ManagerConfig& config, const StartRequest& request,
@@ -99,6 +152,18 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
                                     [&name = name](const OverrideParam& p) { return name == p.name; });
     args.emplace_back(param->flag);
     args.push_back(value);
+  }
+  // The lab's rosbridge: the session dials out under a namespace of its own; the link's robot_control (above)
+  // or else the section's default says who drives. Never --rosbridge-port (kManagerFlags says why).
+  const SessionRos ros = session_ros(config, request, context.session_id);
+  if (!ros.ros_namespace.empty()) {
+    const bool asked = std::any_of(request.overrides.begin(), request.overrides.end(),
+                                   [](const auto& override_) { return override_.first == "robot_control"; });
+    if (!asked) args.insert(args.end(), {"--robot-control", ros.robot_control});
+    args.insert(args.end(), {"--rosbridge-connect", config.ros.connect, "--ros-namespace", ros.ros_namespace,
+                             "--cmd-vel-type", config.ros.cmd_vel_type});
+    if (!config.ros.token_file.empty()) args.insert(args.end(), {"--rosbridge-token-file", config.ros.token_file});
+    if (!config.ros.ca_file.empty()) args.insert(args.end(), {"--rosbridge-ca", config.ros.ca_file});
   }
   // Session data goes to the session's folder; the codes are shown in the picture when the task ends. The
   // relay names each browser's address in a PROXY line, which sim_rfb records hashed.

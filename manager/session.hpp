@@ -99,6 +99,11 @@ struct Session {
   /// trusted proxy names; not its /64), as sim_rfb writes it in events.jsonl (record/digest.hpp,
   /// hash_address); "" when unknown. The index and manager.json keep this, never the address.
   std::string address_hash;
+  /// The session's topics under the lab's ROS when it dials out to the lab's rosbridge_server
+  /// ("/rfbsim/s_12"; "" = no ROS), and who drove its robot ("builtin", "external"; "" = no robot known):
+  /// launch_plan's session_ros. For the researcher only: never on a participant's page.
+  std::string ros_namespace;
+  std::string robot_control;
   /// The participant's stream as sim_rfb last reported it while someone watched; unset before the first report,
   /// when nobody watches, and for sessions read from the index (it is not stored there).
   std::optional<StreamReport> stream;

@@ -41,7 +41,9 @@ CREATE TABLE IF NOT EXISTS sessions (
   copy_state    TEXT NOT NULL DEFAULT '',  -- after_session_command: '' none, pending, done, failed
   copy_attempts INTEGER NOT NULL DEFAULT 0,  -- tries of that command so far
   copy_error    TEXT NOT NULL DEFAULT '',  -- its last failure ("exit 23: ..."); '' when done
-  address_hash  TEXT NOT NULL DEFAULT ''   -- keyed hash of the participant's address (as in events.jsonl)
+  address_hash  TEXT NOT NULL DEFAULT '',  -- keyed hash of the participant's address (as in events.jsonl)
+  ros_namespace TEXT NOT NULL DEFAULT '',  -- its topics under the lab's ROS ("/rfbsim/s_12"); '' = no ROS
+  robot_control TEXT NOT NULL DEFAULT ''   -- who drove the robot: builtin, external; '' = no robot known
 );
 CREATE INDEX IF NOT EXISTS sessions_by_uid ON sessions (uid, id);
 CREATE INDEX IF NOT EXISTS sessions_by_state ON sessions (state);
@@ -64,7 +66,7 @@ CREATE TABLE IF NOT EXISTS uid_acceptors (
 constexpr const char* kColumns =
     "id, uid, token, scenario, params, seed, host_id, state, detail, exit_status, pid, process_start, port, "
     "data_path, created_at, ready_at, ended_at, outcome, code_success, code_timeout, spent_at, data_incomplete, "
-    "copy_state, copy_attempts, copy_error, address_hash";
+    "copy_state, copy_attempts, copy_error, address_hash, ros_namespace, robot_control";
 
 // One prepared statement, finalized on scope exit.
 class Statement {
@@ -137,6 +139,8 @@ Session read_row(Statement& row) {
   s.copy_attempts = static_cast<int>(row.integer(23));
   s.copy_error = row.text(24);
   s.address_hash = row.text(25);
+  s.ros_namespace = row.text(26);
+  s.robot_control = row.text(27);
   return s;
 }
 
@@ -206,6 +210,8 @@ void SessionIndex::add_missing_columns() {
   bool has_spent = false;
   bool has_copy = false;
   bool has_address_hash = false;
+  bool has_ros_namespace = false;
+  bool has_robot_control = false;
   {
     Statement columns(db_, "PRAGMA table_info(sessions)");
     while (columns.step()) {
@@ -213,6 +219,8 @@ void SessionIndex::add_missing_columns() {
       has_spent = has_spent || columns.text(1) == "spent_at";
       has_copy = has_copy || columns.text(1) == "copy_state";
       has_address_hash = has_address_hash || columns.text(1) == "address_hash";
+      has_ros_namespace = has_ros_namespace || columns.text(1) == "ros_namespace";
+      has_robot_control = has_robot_control || columns.text(1) == "robot_control";
     }
   }
   if (!has_codes) {
@@ -230,6 +238,10 @@ void SessionIndex::add_missing_columns() {
   }
   // Sessions recorded before it keep '': their participants' addresses were never hashed.
   if (!has_address_hash) exec("ALTER TABLE sessions ADD COLUMN address_hash TEXT NOT NULL DEFAULT ''");
+  // Sessions recorded before ROS keep '': none of them had any. Each column on its own, so that a crash
+  // between the two leaves nothing half-done for the next start.
+  if (!has_ros_namespace) exec("ALTER TABLE sessions ADD COLUMN ros_namespace TEXT NOT NULL DEFAULT ''");
+  if (!has_robot_control) exec("ALTER TABLE sessions ADD COLUMN robot_control TEXT NOT NULL DEFAULT ''");
 }
 
 void SessionIndex::exec(const char* sql) {
@@ -245,7 +257,7 @@ std::int64_t SessionIndex::insert(const Session& s) {
   Statement insert(db_,
                    "INSERT INTO sessions (uid, token, scenario, params, seed, host_id, state, detail, pid, "
                    "process_start, port, data_path, created_at, code_success, code_timeout, spent_at, address_hash, "
-                   "id) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
+                   "ros_namespace, robot_control, id) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
   insert.bind(1, s.uid);
   insert.bind(2, s.token);
   insert.bind(3, s.scenario);
@@ -263,10 +275,12 @@ std::int64_t SessionIndex::insert(const Session& s) {
   insert.bind(15, s.code_timeout);
   insert.bind(16, s.spent_at);
   insert.bind(17, s.address_hash);
+  insert.bind(18, s.ros_namespace);
+  insert.bind(19, s.robot_control);
   if (s.id > 0) {
-    insert.bind(18, s.id);
+    insert.bind(20, s.id);
   } else {
-    insert.bind_null(18);  // SQLite picks the next id
+    insert.bind_null(20);  // SQLite picks the next id
   }
   insert.step();
   return sqlite3_last_insert_rowid(db_);

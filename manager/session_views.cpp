@@ -38,6 +38,9 @@ std::string status_json(const Session& session, WallTime now, const std::vector<
 }
 
 std::string session_json(const Session& s, bool include_token) {
+  const auto text_or_null = [](const std::string& text) {
+    return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\"";
+  };
   const auto time = [](const std::optional<WallTime>& t) { return t ? "\"" + iso_utc(*t) + "\"" : std::string("null"); };
   std::string json = "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"scenario\":\"" +
                      json_escape(s.scenario) + "\",\"seed\":\"" + std::to_string(s.seed) + "\",\"state\":\"" +
@@ -48,8 +51,9 @@ std::string session_json(const Session& s, bool include_token) {
                      (s.outcome.empty() ? std::string("null") : "\"" + json_escape(s.outcome) + "\"") +
                      ",\"copy_state\":\"" + json_escape(s.copy_state) + "\",\"copy_attempts\":" +
                      std::to_string(s.copy_attempts) + ",\"copy_error\":\"" + json_escape(s.copy_error) +
-                     "\",\"params\":" +
-                     (s.params_json.empty() ? "{}" : s.params_json);
+                     "\",\"params\":" + (s.params_json.empty() ? "{}" : s.params_json) +
+                     ",\"ros_namespace\":" + text_or_null(s.ros_namespace) +
+                     ",\"robot_control\":" + text_or_null(s.robot_control);
   // The stream as sim_rfb last told it; null for what it did not say and when nobody watches.
   const auto decimal = [](const std::optional<double>& value) {
     if (!value) return std::string("null");
@@ -76,7 +80,8 @@ std::string session_record_json(const Session& s) {
          state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"created_at\":\"" + iso_utc(s.created) +
          "\",\"ready_at\":" + time(s.ready_at) + ",\"spent_at\":" + time(s.spent_at) + ",\"ended_at\":" +
          time(s.ended_at) + ",\"outcome\":" + text_or_null(s.outcome) +
-         ",\"data_incomplete\":" + text_or_null(s.data_incomplete) + "}\n";
+         ",\"data_incomplete\":" + text_or_null(s.data_incomplete) + ",\"ros_namespace\":" +
+         text_or_null(s.ros_namespace) + ",\"robot_control\":" + text_or_null(s.robot_control) + "}\n";
 }
 
 }  // namespace rfbsim::manager

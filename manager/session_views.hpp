@@ -27,7 +27,8 @@ std::string status_json(const Session& session, WallTime now, const std::vector<
 
 /// One session for the admin API: id, uid, scenario, seed, state, detail, exit status, times, data path, the
 /// after-session copy ("copy_state": "" | "pending" | "done" | "failed", "copy_attempts", "copy_error"), the
-/// link's parameters, and the participant's stream: "codec" ("tight", "h264"), "rtt_ms" (1 decimal) and "fps"
+/// link's parameters, the session's ROS ("ros_namespace", "robot_control": text or null), and the participant's
+/// stream: "codec" ("tight", "h264"), "rtt_ms" (1 decimal) and "fps"
 /// (1 decimal), each null when unknown or nobody watches; the token only when `include_token` (live sessions,
 /// which a researcher may watch).
 std::string session_json(const Session& session, bool include_token);
@@ -35,8 +36,8 @@ std::string session_json(const Session& session, bool include_token);
 /// The manager's record of a session, written beside the session's own data as manager.json so that the
 /// study's tools (sim_report) see how each session ended without the index: {"id", "uid", "host",
 /// "address_hash", "state", "detail", "created_at", "ready_at", "spent_at", "ended_at", "outcome",
-/// "data_incomplete"} (times ISO 8601 UTC or null; address_hash, outcome and data_incomplete null when there
-/// is none). address_hash is the participant's address hashed as in events.jsonl. No token, address or secret.
+/// "data_incomplete", "ros_namespace", "robot_control"} (times ISO 8601 UTC or null; address_hash, outcome,
+/// data_incomplete, ros_namespace and robot_control null when there is none). address_hash is the participant's address hashed as in events.jsonl. No token, address or secret.
 std::string session_record_json(const Session& session);
 
 }  // namespace rfbsim::manager

@@ -10,7 +10,7 @@ namespace rfbsim::manager {
 
 const std::vector<OverrideParam> kOverrideParams = {
     {"avatar_start", "--avatar-start"}, {"avatar_goal", "--avatar-goal"}, {"robot_start", "--robot-start"},
-    {"robot_goal", "--robot-goal"},     {"crowd", "--crowd"},
+    {"robot_goal", "--robot-goal"},     {"crowd", "--crowd"},       {"robot_control", "--robot-control"},
 };
 
 namespace {
@@ -153,6 +153,14 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
         out.error = "unknown parameter '" + shown(name) + "'";
         return out;
       }
+      // Who drives the robot: the simulator's own planner, or /cmd_vel from a lab's ROS stack (issue 20).
+      if (name == "robot_control") {
+        if (value != "builtin" && value != "external") {
+          out.error = "robot_control '" + shown(value) + "' is not valid: use builtin or external";
+          return out;
+        }
+        continue;
+      }
       const bool crowd = name == "crowd";
       if (crowd ? !is_count(value, kMaxCrowd) : !is_pose(value)) {
         out.error = name + " '" + shown(value) + "' is not valid: " +
@@ -194,11 +202,12 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
   // sim_rfb would refuse these at start-up, after the participant's slot, process and wait: say it now.
   for (const auto& [name, value] : request.overrides) {
     if (name == "crowd") continue;
-    if ((name == "robot_start" || name == "robot_goal") && !known->has_robot) {
+    if ((name == "robot_start" || name == "robot_goal" || name == "robot_control") && !known->has_robot) {
       out.error = name + " is not valid here: scenario " + known->name + " has no robot";
       out.request.reset();
       return out;
     }
+    if (name == "robot_control") continue;  // a mode, not a pose
     if (!names_spawn(value) || std::count(known->spawns.begin(), known->spawns.end(), value) > 0) continue;
     std::string names;
     for (const std::string& spawn : known->spawns) names += (names.empty() ? "" : ", ") + spawn;

@@ -23,7 +23,7 @@ struct StartRequest {
   std::string scenario;               ///< a name from the allowed list
   std::optional<std::uint64_t> seed;  ///< unset = the manager draws one (and records it)
   /// Scenario overrides as (link parameter, value), in the order of kOverrideParams; e.g.
-  /// ("avatar_start", "1.5,-2,0.25") or ("crowd", "10").
+  /// ("avatar_start", "1.5,-2,0.25"), ("crowd", "10") or ("robot_control", "external").
   std::vector<std::pair<std::string, std::string>> overrides;
   /// Completion codes (SEAN-EP's t1 and t2): shown to the participant and sent to the survey on success and
   /// on timeout; identifiers, empty when the link has none.
@@ -34,7 +34,8 @@ struct StartRequest {
   std::optional<std::uint64_t> expires_at;
 };
 
-/// The link parameters that override the scenario, with the sim_rfb flag each becomes.
+/// The link parameters that override the scenario, with the sim_rfb flag each becomes: the poses, crowd (0..500)
+/// and robot_control (builtin or external).
 struct OverrideParam {
   const char* name;  ///< in the link, e.g. "avatar_start"
   const char* flag;  ///< for sim_rfb, e.g. "--avatar-start"
@@ -58,7 +59,8 @@ bool is_pose(std::string_view text);
 StartParse parse_start_request(const QueryParams& params, const std::vector<std::string>& scenarios);
 
 /// As above, then each pose override that names a spawn point must be one of the scenario's (`facts`, found by
-/// name; a scenario without facts is not checked further), and robot_start and robot_goal need a robot:
+/// name; a scenario without facts is not checked further), and robot_start, robot_goal and robot_control need a
+/// robot:
 /// "avatar_start 'dok' is not a spawn point of warehouse (known: dock, aisle_1, ...)".
 StartParse parse_start_request(const QueryParams& params, const std::vector<std::string>& scenarios,
                                const std::vector<ScenarioFacts>& facts);

@@ -301,9 +301,13 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
   // Ids are handed out here, so that the row can be written off this thread; the participant is redirected
   // only once it is committed (below), so a redirect always points at a recorded session.
   session.id = next_id_++;
+  const SessionRos ros = session_ros(config_, request, session.id);
+  session.ros_namespace = ros.ros_namespace;
+  session.robot_control = ros.robot_control;
 
   LaunchContext context;
   context.seed = session.seed;
+  context.session_id = session.id;
   context.data_dir = (std::filesystem::absolute(config_.data_dir) / "sessions" /
                       (std::to_string(session.id) + "-" + session.uid))
                          .string();

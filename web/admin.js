@@ -152,13 +152,13 @@ function syncRows(tbody, sessions, make, update) {
   });
 }
 
-// Live sessions: id, participant, scenario, state, started, age, codec, round trip, frame rate, data folder, Watch
-// and End. Watch opens the
+// Live sessions: id, participant, scenario, state, started, age, codec, round trip, frame rate, robot control,
+// data folder, Watch and End. Watch opens the
 // participant's page under /admin/watch/, where sim_manager relays it view-only: the researcher's keys and clicks
 // never reach the session, and watching does not keep an idle session alive.
 function makeLiveRow(session) {
-  const row = makeRow(session.id, ['num', '', '', '', 'time', 'num', '', 'num', 'num', 'path', 'actions']);
-  const actions = row.cells[10];
+  const row = makeRow(session.id, ['num', '', '', '', 'time', 'num', '', 'num', 'num', '', 'path', 'actions']);
+  const actions = row.cells[11];
   const watch = document.createElement('a');
   watch.target = '_blank';
   watch.rel = 'noopener noreferrer';
@@ -182,8 +182,9 @@ function updateLiveRow(row, session, now) {
   setText(c[6], formatCodec(session.codec));
   setText(c[7], formatNumber(session.rtt_ms, ' ms'));
   setText(c[8], formatNumber(session.fps, ''));
-  setText(c[9], session.data_path);
-  const [watch, end] = c[10].children;
+  setText(c[9], formatRobot(session));
+  setText(c[10], session.data_path);
+  const [watch, end] = c[11].children;
   // Relative to this page (its path prefix included), written out as a path so that it reads plainly.
   const href = session.token
     ? new URL(`admin/watch/${encodeURIComponent(session.token)}/`, document.baseURI).pathname : '';
@@ -199,9 +200,18 @@ function updateLiveRow(row, session, now) {
 }
 
 // Recent (ended) sessions: id, participant, scenario, state, started, ended, duration, detail, exit status, folder,
-// copied.
+// copied, robot control.
 function makeRecentRow(session) {
-  return makeRow(session.id, ['num', '', '', '', 'time', 'time', 'num', '', '', 'path', '']);
+  return makeRow(session.id, ['num', '', '', '', 'time', 'time', 'num', '', '', 'path', '', '']);
+}
+
+// Who drives the robot ("robot_control" from the API) and, when the session dials out to the lab's ROS, its
+// namespace ("ros_namespace"): "external \u00b7 /rfbsim/s_12"; '\u2013' for a scenario without a robot.
+function formatRobot(session) {
+  if (!session.robot_control) {
+    return DASH;
+  }
+  return session.ros_namespace ? `${session.robot_control} \u00b7 ${session.ros_namespace}` : session.robot_control;
 }
 
 // The after-session copy ("copy_state", "copy_attempts", "copy_error" from the API) in words: '\u2013' when none
@@ -233,6 +243,7 @@ function updateRecentRow(row, session) {
   if (c[10].title !== (session.copy_error || '')) {
     c[10].title = session.copy_error || '';
   }
+  setText(c[11], formatRobot(session));
 }
 
 // ---------------------------------------------------------------------------------------------------------------

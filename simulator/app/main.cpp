@@ -7,6 +7,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -25,6 +26,7 @@
 
 #include "app/frame_painter.hpp"
 #include "app/options.hpp"
+#include "app/ros_link.hpp"
 #include "app/session_setup.hpp"
 #include "app/simulation.hpp"
 #include "app/stream_status.hpp"
@@ -208,6 +210,7 @@ rfbsim::sim::SessionSetup setup_of(const rfbsim::sim::SimOptions& options) {
     if (*value) setup.parameters.emplace_back(name, **value);
   }
   if (options.crowd) setup.parameters.emplace_back("crowd", std::to_string(*options.crowd));
+  if (options.robot_control) setup.parameters.emplace_back("robot_control", *options.robot_control);
   return setup;
 }
 
@@ -236,6 +239,65 @@ rfbsim::sim::SessionWriterOptions writer_options_from_environment() {
   return options;
 }
 
+// The dial-out token: the file's first line. Throws std::runtime_error when it cannot be read or is empty; warns
+// when others may read it (it authenticates this study's robot to the lab's ROS).
+std::string read_token_file(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::is_regular_file(status)) {
+    throw std::runtime_error("--rosbridge-token-file " + path + ": not a readable file");
+  }
+  using std::filesystem::perms;
+  if ((status.permissions() & (perms::group_read | perms::others_read)) != perms::none) {
+    std::fprintf(stderr, "[ros] warning: %s can be read by other users; chmod 600 it\n", path.c_str());
+  }
+  std::FILE* file = std::fopen(path.c_str(), "r");
+  if (file == nullptr) throw std::runtime_error("--rosbridge-token-file " + path + ": " + std::strerror(errno));
+  char line[1024] = {};
+  const bool read = std::fgets(line, sizeof line, file) != nullptr;
+  std::fclose(file);
+  std::string token = read ? line : "";
+  while (!token.empty() && (token.back() == '\n' || token.back() == '\r' || token.back() == ' ')) token.pop_back();
+  const bool printable = std::all_of(token.begin(), token.end(), [](unsigned char c) { return c > 0x20 && c < 0x7f; });
+  if (token.empty() || !printable) {
+    throw std::runtime_error("--rosbridge-token-file " + path + ": the first line must hold the token (printable, no spaces)");
+  }
+  return token;
+}
+
+// The ROS side, when asked for: a bag beside the session data and/or a rosbridge server or client. The bag
+// goes in the data folder, which is made here, before the session's own files.
+std::unique_ptr<rfbsim::sim::RosLink> open_ros_link(const rfbsim::sim::SimOptions& options) {
+  const bool bag = !options.data_dir.empty() && options.mcap;
+  if (!bag && !options.rosbridge_port && options.rosbridge_connect.empty()) return nullptr;
+  rfbsim::sim::RosLinkOptions ros;
+  if (bag) {
+    // SessionWriter refuses a folder that holds a session; refuse it here first, before a bag lands in it.
+    if (std::filesystem::exists(std::filesystem::path(options.data_dir) / "session.json")) {
+      throw std::runtime_error(options.data_dir + " already holds a session (session.json); give a new folder");
+    }
+    std::filesystem::create_directories(options.data_dir);
+    ros.bag_file = std::filesystem::path(options.data_dir) / "session.mcap";
+  }
+  ros.server_port = options.rosbridge_port;
+  ros.server_bind = options.rosbridge_bind;
+  ros.connect_url = options.rosbridge_connect;
+  if (!options.rosbridge_token_file.empty()) ros.token = read_token_file(options.rosbridge_token_file);
+  ros.ca_file = options.rosbridge_ca;
+  ros.topic_namespace = options.ros_namespace;
+  ros.cmd_vel_type = options.cmd_vel_type;
+  ros.tick_hz = options.tick_hz;
+  auto link = std::make_unique<rfbsim::sim::RosLink>(std::move(ros));
+  if (const auto port = link->server_port()) {
+    std::fprintf(stderr, "[ros] rosbridge v2 server on ws://%s:%d/ (unauthenticated: keep it on loopback)\n",
+                 options.rosbridge_bind.c_str(), *port);
+  }
+  if (!options.rosbridge_connect.empty()) {
+    std::fprintf(stderr, "[ros] rosbridge client dialling %s\n", options.rosbridge_connect.c_str());
+  }
+  return link;
+}
+
 int run(const rfbsim::sim::SimOptions& options) {
   using Clock = std::chrono::steady_clock;
   namespace sim = rfbsim::sim;
@@ -249,10 +311,22 @@ int run(const rfbsim::sim::SimOptions& options) {
                  prepared.info.scenario_file.c_str(), static_cast<unsigned long long>(prepared.info.seed),
                  simulation.world().people.size());
   }
+  std::unique_ptr<sim::RosLink> ros_link = open_ros_link(options);
+  const sim::RobotStack* robot_stack = simulation.robot_stack();
+  if (robot_stack && robot_stack->control() == sim::RobotControl::kExternal && !options.rosbridge_port &&
+      options.rosbridge_connect.empty()) {
+    std::fprintf(stderr, "[ros] warning: the robot is under external control but no rosbridge is configured "
+                         "(--rosbridge-port or --rosbridge-connect): nothing can drive it, and it will stand still\n");
+  }
   // Session data from the first tick on, when asked for.
   std::unique_ptr<sim::SessionWriter> writer;
   if (!options.data_dir.empty()) {
     sim::SessionInfo info = prepared.info;
+    if (ros_link) {
+      if (options.mcap) info.ros_bag = "session.mcap";
+      info.ros_bridge = ros_link->bridge_description();
+      info.ros_namespace = options.ros_namespace;
+    }
     info.uid = options.uid;
     info.fps = options.fps;
     info.trajectory_hz = options.trajectory_hz;
@@ -263,7 +337,10 @@ int run(const rfbsim::sim::SimOptions& options) {
     }
     writer = std::make_unique<sim::SessionWriter>(options.data_dir, std::move(info), simulation.world(),
                                                   writer_options_from_environment());
+    // The study's events also go to ROS's /events, and into the bag.
+    if (ros_link) writer->set_event_listener([&ros_link](std::uint64_t tick, const std::string& line) { ros_link->event(tick, line); });
   }
+  if (ros_link) ros_link->sample(simulation.world(), simulation.robot_stack());  // tick 0: /map, the scene, the start
   sim::StudySession study(simulation, prepared.task, {options.code_success, options.code_timeout}, writer.get());
   // A recording that stopped (a full disk) is told to the parent once, on the ready pipe; the session goes on.
   const auto report_data_notice = [&] {
@@ -339,6 +416,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   status.publish(sim::status_json(simulation.world(), 0, 0));
   // The parent's line first: if it cannot be told, we are not ready, and stdout should not say we are.
   if (options.ready_fd) report_ready(*options.ready_fd, server);
+  if (ros_link && ros_link->server_port()) std::printf("sim_rfb rosbridge: ws://%s:%d/\n", options.rosbridge_bind.c_str(), *ros_link->server_port());
   std::printf("sim_rfb ready: %s\n", server.url().c_str());
   std::fflush(stdout);
 
@@ -347,6 +425,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   auto last = Clock::now();
   auto next_frame = last;
   bool outcome_reported = false;
+  bool bag_failure_told = false;
   std::string end_reason = "signal";
   while (!g_stop) {
     const auto now = Clock::now();
@@ -372,9 +451,27 @@ int run(const rfbsim::sim::SimOptions& options) {
         study.pointer(event.x, event.y, event.buttons, event.client_id);
       }
     }
+    // An external controller's commands, like keys, are recorded at this tick and drive from the next. Only the
+    // last one taken now can matter (each replaces the one before), so only it is recorded: a controller that
+    // floods /cmd_vel costs no disk, and the replay is the same.
+    if (ros_link) {
+      std::vector<sim::RobotCommand> commands = ros_link->take_commands();
+      if (!commands.empty() && !study.robot_command(commands.back().v, commands.back().w, commands.back().source)) {
+        for (const sim::RobotCommand& command : commands) {
+          ros_link->warn_ignored(command, "the robot is under built-in control; /cmd_vel is ignored "
+                                          "(start the session with robot_control external)");
+        }
+      }
+      if (const auto failure = ros_link->bag_failure(); failure && !bag_failure_told) {
+        bag_failure_told = true;
+        std::fprintf(stderr, "[ros] session.mcap stopped growing: %s (the session and its other files go on)\n",
+                     failure->c_str());
+      }
+    }
     for (int i = 0; i < ticks && !study.over(); ++i) {
       study.step();
       log_robot_events(simulation.world(), simulation.params().dt);
+      if (ros_link) ros_link->sample(simulation.world(), simulation.robot_stack());
     }
     // The outcome goes to the parent (sim_manager tells the survey) as soon as it is reached.
     if (!outcome_reported && study.outcome() != sim::TaskOutcome::None) {
@@ -391,6 +488,7 @@ int run(const rfbsim::sim::SimOptions& options) {
       break;
     }
     if (writer) writer->flush_if_due();
+    if (ros_link) ros_link->flush_if_due();
     report_data_notice();
     const int clients = server.client_count();
     if (ticks > 0 && !options.rfb_only) {
@@ -412,6 +510,7 @@ int run(const rfbsim::sim::SimOptions& options) {
     std::this_thread::sleep_until(wake);
   }
   study.finish(end_reason);
+  if (ros_link) ros_link->finish();  // after the end's events, which the bag records too
   report_data_notice();  // the end's own writes may have been the ones that failed
   if (options.ready_fd) ::close(*options.ready_fd);
   std::fprintf(stderr, "[sim_rfb] stopping after %llu ticks, %llu frames (%s)\n",

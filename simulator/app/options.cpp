@@ -43,6 +43,41 @@ bool looks_like_origin(const std::string& text) {
   return false;
 }
 
+// A ROS graph name used as a topic prefix: "/" then segments of letters, digits and _ (each starting with a
+// letter), joined by "/", no trailing "/".
+bool is_ros_namespace(const std::string& text) {
+  // sim_manager accepts a 200-character root and appends "/s_<id>_<host>": 512 leaves room for both.
+  if (text.size() < 2 || text.size() > 512 || text[0] != '/') return false;
+  bool segment_start = true;
+  for (std::size_t i = 1; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '/') {
+      if (segment_start) return false;
+      segment_start = true;
+      continue;
+    }
+    const bool letter = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
+    const bool ok = letter || (!segment_start && ((c >= '0' && c <= '9') || c == '_'));
+    if (!ok) return false;
+    segment_start = false;
+  }
+  return !segment_start;
+}
+
+// ws://host[:port][/path] or wss://...: the shape only (the client parses it fully when it starts). No user info
+// and no query: credentials go in --rosbridge-token-file, never in a URL that logs, session.json and ps show.
+bool looks_like_websocket_url(const std::string& text) {
+  for (const std::string scheme : {"ws://", "wss://"}) {
+    if (text.rfind(scheme, 0) == 0) {
+      const std::string authority = text.substr(scheme.size(), text.find('/', scheme.size()) - scheme.size());
+      return text.size() > scheme.size() && text.size() <= 2048 && !authority.empty() &&
+             authority.find('@') == std::string::npos && text.find_first_of("?#") == std::string::npos &&
+             std::none_of(text.begin(), text.end(), [](unsigned char c) { return c <= 0x20 || c == 0x7f; });
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 std::string sim_usage() {
@@ -54,7 +89,10 @@ std::string sim_usage() {
          "               [--debug-overlay] [--rfb-only] [--proxy-protocol] [--ready-fd N]\n"
          "               [--allow-origin ORIGIN]... [--unix-socket PATH]\n"
          "               [--data-dir DIR] [--uid ID] [--code-success C] [--code-timeout C]\n"
-         "               [--time-limit S] [--trajectory-hz N]\n"
+         "               [--time-limit S] [--trajectory-hz N] [--no-mcap] [--robot-control C]\n"
+         "               [--rosbridge-port N] [--rosbridge-bind ADDR] [--rosbridge-connect URL]\n"
+         "               [--rosbridge-token-file F] [--rosbridge-ca F] [--ros-namespace NS]\n"
+         "               [--cmd-vel-type twist|twist_stamped]\n"
          "  --port N         TCP port for the page, WebSocket and RFB (default 5901; 0 = any free port)\n"
          "  --bind ADDR      numeric address to listen on (default 127.0.0.1)\n"
          "  --width W        frame width in pixels, 160..3840 (default 1280)\n"
@@ -98,7 +136,20 @@ std::string sim_usage() {
          "                   completion codes shown when the task is done or the time is up (1..64 of\n"
          "                   letters, digits, - and _; SEAN-EP's t1 and t2)\n"
          "  --time-limit S   the task's time limit in seconds, 1..86400 (default: the scenario's)\n"
-         "  --trajectory-hz N  trajectory rows per second, a divisor of the tick rate 60 (default 10)\n";
+         "  --trajectory-hz N  trajectory rows per second, a divisor of the tick rate 60 (default 10)\n"
+         "  --no-mcap        with --data-dir, do not write session.mcap (the ROS 2 bag, docs/ros.md)\n"
+         "  --robot-control C  builtin (the robot's own navigation stack) or external (/cmd_vel over rosbridge\n"
+         "                   drives it; it stops 0.5 s after the last command) (default: the scenario's)\n"
+         "  --rosbridge-port N  serve the ROS topics live over rosbridge v2 (JSON over WebSocket at /) on\n"
+         "                   port N (0 = any free port). Unauthenticated: keep it on loopback\n"
+         "  --rosbridge-bind ADDR  numeric address for --rosbridge-port (default 127.0.0.1)\n"
+         "  --rosbridge-connect URL  dial out to a lab's rosbridge_server (ws:// or wss://) and publish there,\n"
+         "                   taking /cmd_vel from it; reconnects by itself\n"
+         "  --rosbridge-token-file F  send F's first line as 'Authorization: Bearer' when dialling out\n"
+         "  --rosbridge-ca F  extra CA certificates (PEM) to trust for wss://\n"
+         "  --ros-namespace NS  put every topic under NS (e.g. /rfbsim/s1): /rfbsim/s1/scan\n"
+         "  --cmd-vel-type T twist (geometry_msgs/msg/Twist, the default) or twist_stamped: the type\n"
+         "                   --rosbridge-connect subscribes to the lab's /cmd_vel with (--rosbridge-port takes both)\n";
 }
 
 ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
@@ -164,6 +215,25 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
       {"--trajectory-hz", [&](const std::string& v) {
          return parse_number(v, 1, 60, o.trajectory_hz) && 60 % o.trajectory_hz == 0;
        }},
+      {"--robot-control", [&](const std::string& v) {
+         o.robot_control = v;
+         return v == "builtin" || v == "external";
+       }},
+      {"--rosbridge-port", [&](const std::string& v) {
+         int port = 0;
+         if (!parse_number(v, 0, 65535, port)) return false;
+         o.rosbridge_port = port;
+         return true;
+       }},
+      {"--rosbridge-bind", [&](const std::string& v) { o.rosbridge_bind = v; return !v.empty(); }},
+      {"--rosbridge-connect", [&](const std::string& v) { o.rosbridge_connect = v; return looks_like_websocket_url(v); }},
+      {"--rosbridge-token-file", [&](const std::string& v) { o.rosbridge_token_file = v; return !v.empty(); }},
+      {"--rosbridge-ca", [&](const std::string& v) { o.rosbridge_ca = v; return !v.empty(); }},
+      {"--ros-namespace", [&](const std::string& v) { o.ros_namespace = v; return is_ros_namespace(v); }},
+      {"--cmd-vel-type", [&](const std::string& v) {
+         o.cmd_vel_type = v == "twist_stamped" ? "geometry_msgs/msg/TwistStamped" : "geometry_msgs/msg/Twist";
+         return v == "twist" || v == "twist_stamped";
+       }},
       {"--egl", [&](const std::string& v) {
          o.egl_platform = v;
          return v == "auto" || v == "device" || v == "surfaceless";
@@ -189,6 +259,10 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
       o.proxy_protocol = true;
       continue;
     }
+    if (arg == "--no-mcap") {
+      o.mcap = false;
+      continue;
+    }
     auto option = with_value.find(arg);
     if (option == with_value.end()) {
       outcome.error = "unknown argument '" + arg + "'";
@@ -204,11 +278,21 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
       // A choice among names is spelt out, so that a typo is fixed without reading the help.
       if (arg == "--codec") outcome.error += " (expected auto, jpeg or h264)";
       if (arg == "--allow-origin") outcome.error += " (expected scheme://host[:port] with http or https, or *)";
+      if (arg == "--robot-control") outcome.error += " (expected builtin or external)";
+      if (arg == "--cmd-vel-type") outcome.error += " (expected twist or twist_stamped)";
+      if (arg == "--rosbridge-connect") {
+        outcome.error += " (expected ws://host[:port][/path] or wss://..., without user info or query: a token goes in "
+                         "--rosbridge-token-file)";
+      }
+      if (arg == "--ros-namespace") outcome.error += " (expected a ROS name such as /rfbsim/s1)";
       return outcome;
     }
   }
   // Without HTTP there is no page to serve: a web root given anyway shows a misunderstanding.
   if (o.rfb_only && !o.web_root.empty()) outcome.error = "--rfb-only serves no page; drop --web-root";
+  if ((!o.rosbridge_token_file.empty() || !o.rosbridge_ca.empty()) && o.rosbridge_connect.empty()) {
+    outcome.error = "--rosbridge-token-file and --rosbridge-ca are for --rosbridge-connect; give it too";
+  }
   // Silently ignoring them would leave the caller believing a TCP port is open.
   if (!o.unix_socket.empty() && port_or_bind_given) {
     outcome.error = "--unix-socket replaces --port and --bind; drop them";

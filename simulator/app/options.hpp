@@ -50,6 +50,20 @@ struct SimOptions {
   std::string code_timeout;         ///< completion code shown on timeout (t2); empty = none
   std::optional<int> time_limit;    ///< s, the task's time limit instead of the scenario's
   int trajectory_hz = 10;           ///< trajectory rows per second; divides tick_hz
+  bool mcap = true;                 ///< with data_dir, also write session.mcap (--no-mcap: not)
+  /// Who drives the robot: "builtin" or "external" (a link parameter like the poses; unset = the scenario's).
+  std::optional<std::string> robot_control;
+  /// ROS (docs/ros.md): a rosbridge v2 server on this port (0 = any free port), unauthenticated, so loopback
+  /// by default; and/or a rosbridge client dialling out to `rosbridge_connect` (ws:// or wss://).
+  std::optional<int> rosbridge_port;
+  std::string rosbridge_bind = "127.0.0.1";
+  std::string rosbridge_connect;
+  std::string rosbridge_token_file;  ///< its first line is sent as a Bearer token when dialling out
+  std::string rosbridge_ca;          ///< extra CA certificates for wss://
+  std::string ros_namespace;         ///< prefix of every topic on the wire ("" or e.g. /rfbsim/s1)
+  /// The type the dial-out subscribes to /cmd_vel with (a lab's rosbridge_server needs one): Twist, or
+  /// TwistStamped as Jazzy-era stacks publish it. Our own server takes either whatever this says.
+  std::string cmd_vel_type = "geometry_msgs/msg/Twist";
   bool help = false;
 };
 

@@ -24,6 +24,8 @@ ScenarioOverrides overrides_of(const SessionSetup& setup) {
       overrides.robot_start = value;
     } else if (name == "robot_goal") {
       overrides.robot_goal = value;
+    } else if (name == "robot_control") {
+      overrides.robot_control = value;
     } else if (name == "crowd") {
       int count = -1;
       const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), count);
@@ -64,6 +66,7 @@ PreparedSession prepare_session(const SessionSetup& setup) {
   if (setup.time_limit) scenario.task.time_limit = *setup.time_limit;
 
   info.scenario = scenario.name;
+  if (scenario.robot.present) info.robot_control = robot_control_name(scenario.robot.control);
   info.scenario_file = std::filesystem::absolute(file).lexically_normal().string();
   info.seed = scenario.seed;
   info.scenario_sha256 = sha256_file(file);

@@ -49,6 +49,10 @@ void Simulation::step() {
   world_.time = static_cast<double>(world_.tick) * params_.dt;
 }
 
+bool Simulation::command_robot(double v, double w) {
+  return robot_ != nullptr && robot_->external_command(world_, v, w);
+}
+
 std::optional<std::string> Simulation::send_robot_goal(const Pose2& goal) {
   if (!robot_) return std::string("there is no robot");
   return robot_->send_goal(world_, goal);

@@ -51,6 +51,9 @@ class Simulation {
   [[nodiscard]] const RobotStack* robot_stack() const { return robot_.get(); }
   /// Sends the robot to `goal` (see RobotStack::send_goal); the reason when refused or there is no robot.
   std::optional<std::string> send_robot_goal(const Pose2& goal);
+  /// An external controller's velocity command (docs/ros.md), applied from the next step; false when there is
+  /// no robot or it is not under external control (the command is then ignored).
+  bool command_robot(double v, double w);
 
  private:
   SimulationParams params_;

@@ -21,6 +21,15 @@ void StudySession::key(std::uint32_t keysym, bool down, int client) {
   simulation_.apply_key(keysym, down);
 }
 
+bool StudySession::robot_command(double v, double w, const std::string& source) {
+  const RobotStack* robot = simulation_.robot_stack();
+  if (robot == nullptr || robot->control() != RobotControl::kExternal) return false;
+  if (writer_ != nullptr) {
+    writer_->event(simulation_.world().tick, "robot_command", {{"v", v}, {"w", w}, {"source", source}});
+  }
+  return simulation_.command_robot(v, w);
+}
+
 void StudySession::pointer(int x, int y, int buttons, int client) {
   if (writer_ == nullptr) return;
   writer_->event(simulation_.world().tick, "pointer", {{"x", x}, {"y", y}, {"buttons", buttons}, {"client", client}});

@@ -34,6 +34,10 @@ class StudySession {
 
   /// A key event; it takes effect from the next step. `client` 0: librfbsim releasing a leaver's keys.
   void key(std::uint32_t keysym, bool down, int client);
+  /// An external controller's velocity command (ROS /cmd_vel, docs/ros.md), recorded as a `robot_command`
+  /// event with its `source` and applied from the next step, as a key is. False (and nothing recorded) when the
+  /// robot is not under external control: the command is ignored.
+  bool robot_command(double v, double w, const std::string& source);
   /// Pointer moves and buttons: recorded, not used.
   void pointer(int x, int y, int buttons, int client);
   /// A viewer arrived: recorded with its hashed address and role; the first participant starts the task's

@@ -113,6 +113,11 @@ SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const 
               {"time_limit_s", info_.time_limit ? json(*info_.time_limit) : json(nullptr)},
               {"codes", info_.codes ? json{{"success", info_.codes->first}, {"timeout", info_.codes->second}}
                                     : json(nullptr)},
+              {"robot_control", info_.robot_control.empty() ? json(nullptr) : json(info_.robot_control)},
+              {"ros",
+               {{"bag", info_.ros_bag.empty() ? json(nullptr) : json(info_.ros_bag)},
+                {"bridge", info_.ros_bridge.empty() ? json(nullptr) : json(info_.ros_bridge)},
+                {"namespace", info_.ros_namespace.empty() ? json(nullptr) : json(info_.ros_namespace)}}},
               {"started_at", iso_utc_now()},
               {"ended_at", nullptr},
               {"end_tick", nullptr},
@@ -168,8 +173,10 @@ void SessionWriter::event(std::uint64_t tick, const char* type, const nlohmann::
   for (const auto& [key, value] : fields.items()) line[key] = value;
   // Strings from outside (robot details, task texts) may hold any bytes: replace what is not UTF-8
   // rather than throw in the middle of a session.
-  events_buffer_ += line.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  const std::string text = line.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  events_buffer_ += text;
   events_buffer_ += '\n';
+  if (event_listener_) event_listener_(tick, text);
 }
 
 void SessionWriter::world_events(const World& world) {

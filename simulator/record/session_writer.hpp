@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -38,6 +39,10 @@ struct SessionInfo {
   std::vector<std::pair<std::string, std::string>> tasks;  ///< (type, text) per step
   std::optional<double> time_limit;  ///< s; none without a task
   std::optional<std::pair<std::string, std::string>> codes;  ///< (success, timeout)
+  std::string robot_control;  ///< who drives the robot: "builtin" or "external"; empty = no robot
+  /// What the session gave ROS (docs/ros.md): the bag's file name, the bridge ("server ADDR:PORT" or
+  /// "client URL") and the topics' namespace; empty = none.
+  std::string ros_bag, ros_bridge, ros_namespace;
 };
 
 /// How the session ended, for session.json's end keys.
@@ -71,6 +76,11 @@ class SessionWriter {
   void sample(const World& world);
   /// Appends one event line: `fields` plus tick, time and type first.
   void event(std::uint64_t tick, const char* type, const nlohmann::ordered_json& fields = nlohmann::ordered_json::object());
+  /// Called with every event line (without its newline) as it is formatted, on the caller's thread: sim_rfb
+  /// publishes the study's events on ROS's /events topic from it.
+  void set_event_listener(std::function<void(std::uint64_t tick, const std::string& line)> listener) {
+    event_listener_ = std::move(listener);
+  }
   /// The contacts and robot state changes of the world's last tick, as events.
   void world_events(const World& world);
 
@@ -110,6 +120,7 @@ class SessionWriter {
   std::uint64_t sample_every_ = 6;
   std::chrono::milliseconds flush_interval_;
   std::chrono::steady_clock::time_point last_flush_;
+  std::function<void(std::uint64_t, const std::string&)> event_listener_;
   std::unique_ptr<SyncQueue> queue_;  // last: started once the folder is in place
 };
 

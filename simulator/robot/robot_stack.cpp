@@ -6,6 +6,7 @@
 #include <chrono>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 
@@ -61,6 +62,16 @@ RobotSetup synced(RobotSetup setup, double robot_radius) {
 
 }  // namespace
 
+const char* robot_control_name(RobotControl control) {
+  return control == RobotControl::kExternal ? "external" : "builtin";
+}
+
+std::optional<RobotControl> robot_control_from_name(std::string_view name) {
+  if (name == "builtin") return RobotControl::kBuiltin;
+  if (name == "external") return RobotControl::kExternal;
+  return std::nullopt;
+}
+
 void people_in_view(const World& world, const Pose2& pose, double range, std::vector<SeenPerson>& out) {
   out.clear();
   const auto consider = [&](const Eigen::Vector2d& at, const Eigen::Vector2d& velocity, double radius) {
@@ -88,6 +99,9 @@ RobotStack::RobotStack(const World& world, RobotSetup setup)
       mission_(setup_.mission, setup_.seed ^ 0x6d697373ULL),
       lidar_rng_(setup_.seed ^ 0x6c696461ULL) {
   check_lidar_params(setup_.params.lidar);
+  if (!(setup_.command_timeout > 0.0) || !std::isfinite(setup_.command_timeout)) {
+    throw std::invalid_argument("command_timeout must be a positive number of seconds");
+  }
   positive_rate(setup_.params.navigator.controller_frequency, "controller_frequency");
   positive_rate(setup_.params.global_update_frequency, "global_update_frequency");
   if (setup_.params.localization == Localization::Amcl) {
@@ -105,6 +119,7 @@ void RobotStack::step(World& world, double dt) {
     mission_started_ = true;
     next_mission_goal(world);
   }
+  if (setup_.control == RobotControl::kExternal) watch_external_commands(world);
 
   // Sense: the wheels count every tick; the lidar sweeps at its own rate, from the true pose.
   odometry_.update(robot.pose);
@@ -113,11 +128,16 @@ void RobotStack::step(World& world, double dt) {
     collect_lidar_bodies(world, bodies_);
     cast_scan_into(scan_, world.obstacles, bodies_, robot.pose, now, setup_.params.lidar, lidar_rng_);
     scan_fresh_ = true;
+    ++scans_;
     next_scan_time_ = std::max(next_scan_time_ + 1.0 / setup_.params.lidar.rate_hz, now);
   }
   // Localize, map, plan at the controller's rate; the mission moves on after a pause at a waypoint.
   if (now + 1e-9 >= next_cycle_time_) {
-    control_cycle(world);
+    if (setup_.control == RobotControl::kExternal) {
+      external_cycle(world);
+    } else {
+      control_cycle(world);
+    }
     next_cycle_time_ = std::max(next_cycle_time_ + 1.0 / setup_.params.navigator.controller_frequency, now);
   }
   if (resume_mission_at_ >= 0.0 && now + 1e-9 >= resume_mission_at_) {
@@ -130,11 +150,9 @@ void RobotStack::step(World& world, double dt) {
   record_events(world);
 }
 
-void RobotStack::control_cycle(World& world) {
-  Robot& robot = *world.robot;
-  const double now = world.time;
-  ++cycles_;
-
+// Where the robot believes it is: AMCL on the odometry and the fresh scan, or the true pose without AMCL.
+// Written to Robot::estimate and returned.
+Pose2 RobotStack::localize(Robot& robot) {
   Pose2 estimate = robot.pose;
   if (amcl_) {
     StageTimer timer(times_, NavStage::Localization);
@@ -142,6 +160,14 @@ void RobotStack::control_cycle(World& world) {
     estimate = amcl_->estimate();
   }
   robot.estimate = estimate;
+  return estimate;
+}
+
+void RobotStack::control_cycle(World& world) {
+  Robot& robot = *world.robot;
+  const double now = world.time;
+  ++cycles_;
+  const Pose2 estimate = localize(robot);
 
   {
     // The people detector sees from the true pose; what it reports lands where the robot believes it is.
@@ -183,7 +209,7 @@ void RobotStack::control_cycle(World& world) {
     global_.clear_obstacles_beyond(at, *command.clear_obstacles_beyond);
     local_.clear_obstacles_beyond(at, *command.clear_obstacles_beyond);
   }
-  drive_.command(command.v, command.w);
+  command_drive(command.v, command.w, now);
 
   // A patrol or a wander goes on to its next waypoint after a pause, whether this one was reached or not.
   const RobotState state = navigator_.state();
@@ -217,6 +243,12 @@ void RobotStack::control_cycle(World& world) {
 
 void RobotStack::next_mission_goal(World& world) {
   if (const auto goal = mission_.next_goal()) {
+    mission_goal_ = *goal;
+    if (setup_.control == RobotControl::kExternal) {
+      // The controller outside is told the goal (ROS's /goal_pose); reaching it is its business.
+      world.robot->nav.goal = *goal;
+      return;
+    }
     goal_finished_ = false;
     navigator_.set_goal(*goal, world.obstacles, world.robot->radius);
     world.robot->state = navigator_.state();
@@ -227,9 +259,64 @@ std::optional<std::string> RobotStack::send_goal(World& world, const Pose2& goal
   resume_mission_at_ = -1.0;
   goal_finished_ = false;
   mission_started_ = true;  // a goal sent before the first tick is not replaced by the mission's first
+  mission_goal_ = goal;
+  if (setup_.control == RobotControl::kExternal) {
+    world.robot->nav.goal = goal;
+    return std::nullopt;
+  }
   auto refusal = navigator_.set_goal(goal, world.obstacles, world.robot->radius);
   world.robot->state = navigator_.state();
   return refusal;
+}
+
+void RobotStack::command_drive(double v, double w, double now) {
+  drive_.command(v, w);
+  if (command_.sequence > 0 && command_.v == v && command_.w == w) return;  // the same command again: not news
+  command_ = {v, w, now, command_.sequence + 1};
+}
+
+bool RobotStack::external_command(const World& world, double v, double w) {
+  if (setup_.control != RobotControl::kExternal) return false;
+  external_v_ = std::isfinite(v) ? v : 0.0;
+  external_w_ = std::isfinite(w) ? w : 0.0;
+  external_time_ = world.time;
+  return true;
+}
+
+// Every tick under external control: the latest command goes to the wheels at once (not at the next control
+// cycle), so that a command takes effect within a tick of arriving; a command older than the timeout stops the
+// robot once, with an event saying so, and the next fresh command drives it again.
+void RobotStack::watch_external_commands(World& world) {
+  const bool fresh = external_time_ >= 0.0 && world.time - external_time_ <= setup_.command_timeout + 1e-9;
+  if (fresh) {
+    if (external_stale_) {
+      external_stale_ = false;
+      world.robot->state = RobotState::Moving;
+      world.robot_events.push_back({world.tick, RobotState::Moving, "external control: commands arriving"});
+    }
+    command_drive(external_v_, external_w_, external_time_);
+    return;
+  }
+  if (!external_stale_) {
+    external_stale_ = true;
+    world.robot->state = RobotState::Idle;
+    char detail[96];
+    std::snprintf(detail, sizeof detail, "external control: no command for %.2f s, stopped", setup_.command_timeout);
+    world.robot_events.push_back({world.tick, RobotState::Idle, detail});
+    command_drive(0.0, 0.0, world.time);
+  }
+}
+
+// The control cycle under external control: localization still runs (the robot's belief is published as
+// map->odom), the costmaps and planners do not (nobody reads them, and they are most of the stack's cost).
+void RobotStack::external_cycle(World& world) {
+  Robot& robot = *world.robot;
+  ++cycles_;
+  localize(robot);
+  scan_fresh_ = false;
+  robot.nav.global_path.clear();
+  robot.nav.local_trajectory.clear();
+  head_target_ = 0.0;
 }
 
 void RobotStack::record_events(World& world) {

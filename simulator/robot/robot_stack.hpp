@@ -12,6 +12,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "robot/costmap/layered_costmap.hpp"
@@ -22,11 +23,32 @@
 
 namespace rfbsim::sim {
 
+/// Who drives the robot: its own navigation stack, or a controller outside (a lab's ROS stack over rosbridge,
+/// docs/ros.md) whose velocity commands go straight to the wheels.
+enum class RobotControl { kBuiltin, kExternal };
+
+/// "builtin" or "external", as scenarios, links, flags and session data spell it.
+const char* robot_control_name(RobotControl control);
+/// The control named `name` ("builtin" or "external"); none for anything else.
+std::optional<RobotControl> robot_control_from_name(std::string_view name);
+
 /// Everything that configures one robot in a session: its model, its mission and its random streams' seed.
 struct RobotSetup {
   RobotParams params;
   MissionSpec mission;
   std::uint64_t seed = 1;
+  RobotControl control = RobotControl::kBuiltin;
+  /// s of simulated time after the last external command when the robot stops (the watchdog; ROS's
+  /// controllers commonly use 0.5 s). External control only.
+  double command_timeout = 0.5;
+};
+
+/// The velocity the wheels were last told to reach (the navigator's, or an external controller's).
+struct DriveCommand {
+  double v = 0.0;              ///< m/s forward
+  double w = 0.0;              ///< rad/s counter-clockwise
+  double time = 0.0;           ///< simulated s when it was given
+  std::uint64_t sequence = 0;  ///< commands given so far: a reader sees a new one when this changes
 };
 
 /// The stages of the stack whose cost bench_nav reports.
@@ -54,6 +76,23 @@ class RobotStack {
   /// Sends the robot to `goal` now (the mission's next goals follow when it arrives). Returns the reason
   /// when the goal is refused (inside a wall or prop, or off the map).
   std::optional<std::string> send_goal(World& world, const Pose2& goal);
+  /// External control: the wheels aim for (v, w) from the next tick until a newer command, or until
+  /// command_timeout passes without one (then the robot stops, and a RobotEvent says so). Non-finite values
+  /// read as stop. Ignored, returning false, under built-in control.
+  bool external_command(const World& world, double v, double w);
+
+  [[nodiscard]] RobotControl control() const { return setup_.control; }
+  /// The wheel odometry's pose, in the odom frame (which starts as the map frame and drifts).
+  [[nodiscard]] const Pose2& odometry_pose() const { return odometry_.pose(); }
+  /// The lidar's latest sweep (empty ranges before the first) and how many sweeps were cast so far.
+  [[nodiscard]] const LaserScan& last_scan() const { return scan_; }
+  [[nodiscard]] std::uint64_t scans() const { return scans_; }
+  /// What the wheels were last told, and their actual forward speed and turn rate now.
+  [[nodiscard]] const DriveCommand& last_command() const { return command_; }
+  [[nodiscard]] double wheel_v() const { return drive_.v(); }
+  [[nodiscard]] double wheel_w() const { return drive_.w(); }
+  /// The goal the scenario's mission gives the robot now, under either control (none without a mission).
+  [[nodiscard]] const std::optional<Pose2>& mission_goal() const { return mission_goal_; }
 
   [[nodiscard]] const StageTimes& stage_times() const { return times_; }
   [[nodiscard]] const Navigator& navigator() const { return navigator_; }
@@ -65,9 +104,13 @@ class RobotStack {
 
  private:
   void control_cycle(World& world);
+  Pose2 localize(Robot& robot);
   void next_mission_goal(World& world);
   void record_events(World& world);
   void turn_head(Robot& robot, double dt) const;
+  void command_drive(double v, double w, double now);
+  void external_cycle(World& world);
+  void watch_external_commands(World& world);
 
   RobotSetup setup_;
   DiffDrive drive_;
@@ -93,6 +136,12 @@ class RobotStack {
   std::uint64_t cycles_ = 0;
   StageTimes times_;
   double head_target_ = 0.0;  // rad against the body, where the head should look
+  std::uint64_t scans_ = 0;
+  DriveCommand command_;
+  std::optional<Pose2> mission_goal_;
+  // External control: the latest command's (v, w) and time; whether the watchdog has stopped the robot.
+  double external_v_ = 0.0, external_w_ = 0.0, external_time_ = -1.0;
+  bool external_stale_ = true;
 };
 
 /// The people the robot's lidar can see from `pose` in `world`: each person and the avatar whose centre is

@@ -174,8 +174,16 @@ void parse_crowd(Scenario& scenario, const GridMap& obstacles, const YamlField& 
 }
 
 void parse_robot(Scenario& scenario, const YamlField& robot) {
-  robot.allow_only({"start", "mission", "nav"});
+  robot.allow_only({"start", "mission", "nav", "control", "command_timeout"});
   if (auto nav = robot.optional("nav")) parse_robot_params(*nav, scenario.robot.params);
+  if (auto control = robot.optional("control")) {
+    const auto parsed = robot_control_from_name(control->text());
+    if (!parsed) control->fail_with("expected 'builtin' or 'external'");
+    scenario.robot.control = *parsed;
+  }
+  if (auto timeout = robot.optional("command_timeout")) {
+    scenario.robot.command_timeout = timeout->number(0.05, 60.0);
+  }
   scenario.robot.present = true;
   scenario.robot.start = parse_place(scenario, robot.required("start"));
   auto mission_field = robot.optional("mission");
@@ -395,8 +403,17 @@ void apply_overrides(Scenario& scenario, const ScenarioOverrides& overrides) {
     // Reach steps without a landmark of their own go to the goal the link gave.
     resolve_task_targets(scenario.task, scenario.landmarks, &*scenario.avatar_goal);
   }
-  if (overrides.robot_start || overrides.robot_goal) {
-    if (!scenario.robot.present) throw ScenarioError("--robot-start/--robot-goal: scenario " + scenario.name + " has no robot");
+  if (overrides.robot_start || overrides.robot_goal || overrides.robot_control) {
+    if (!scenario.robot.present) {
+      throw ScenarioError("--robot-start/--robot-goal/--robot-control: scenario " + scenario.name + " has no robot");
+    }
+  }
+  if (overrides.robot_control) {
+    const auto control = robot_control_from_name(*overrides.robot_control);
+    if (!control) {
+      throw ScenarioError("--robot-control: expected 'builtin' or 'external', got '" + *overrides.robot_control + "'");
+    }
+    scenario.robot.control = *control;
   }
   if (overrides.robot_start) scenario.robot.start = checked("--robot-start", *overrides.robot_start, kRobotClearance, nullptr);
   if (overrides.robot_goal) {
@@ -412,6 +429,8 @@ RobotSetup robot_setup(const Scenario& scenario) {
   RobotSetup setup;
   setup.params = scenario.robot.params;
   setup.mission = scenario.robot.mission;
+  setup.control = scenario.robot.control;
+  setup.command_timeout = scenario.robot.command_timeout;
   // The robot's streams (lidar noise, odometry drift, particles, wander picks) apart from the crowd's.
   setup.seed = scenario.seed * 0x9e3779b97f4a7c15ULL + 0x726f626f74ULL;
   return setup;

@@ -37,6 +37,9 @@ struct RobotSpec {
   Pose2 start;
   MissionSpec mission;
   RobotParams params;  ///< defaults, overridden by the file's `robot.nav`
+  /// `robot.control`: the built-in stack drives, or an external controller over ROS (docs/ros.md).
+  RobotControl control = RobotControl::kBuiltin;
+  double command_timeout = 0.5;  ///< `robot.command_timeout`, s: external control's watchdog
 };
 
 struct Scenario {
@@ -74,6 +77,7 @@ struct ScenarioOverrides {
   std::optional<std::string> robot_goal;
   std::optional<std::uint64_t> seed;
   std::optional<int> crowd_count;
+  std::optional<std::string> robot_control;  ///< "builtin" or "external" (--robot-control, the link's robot_control)
 };
 
 /// Applies overrides and re-checks the poses against the map. Throws ScenarioError naming the option

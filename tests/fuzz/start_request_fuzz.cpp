@@ -62,7 +62,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check(index < kOverrideParams.size(), "unknown override passed");
     check(index >= last, "overrides out of their fixed order");
     last = index;
-    check(name == "crowd" ? is_count(value) : is_pose(value), "override value not valid");
+    const bool valid = name == "crowd"           ? is_count(value)
+                       : name == "robot_control" ? (value == "builtin" || value == "external")
+                                                 : is_pose(value);
+    check(valid, "override value not valid");
   }
   return 0;
 }

@@ -80,6 +80,17 @@ void SessionReplay::apply(const sim::Event& event) {
       throw sim::SessionLogError("events.jsonl: key event at tick " + std::to_string(event.tick) + ": keysym out of range");
     }
     study_->key(static_cast<std::uint32_t>(keysym), event.flag("down"), small_int(event, "client"));
+  } else if (event.type == "robot_command") {
+    // An external controller's command (docs/ros.md): the replay drives the robot as it was driven.
+    const auto number = [&event](const char* key) {
+      const auto found = event.fields.find(key);
+      if (found == event.fields.end() || !found->is_number()) {
+        throw sim::SessionLogError("events.jsonl: robot_command event at tick " + std::to_string(event.tick) +
+                                   ": '" + key + "' is not a number");
+      }
+      return found->get<double>();
+    };
+    study_->robot_command(number("v"), number("w"), event.text("source"));
   } else if (event.type == "pointer") {
     study_->pointer(small_int(event, "x"), small_int(event, "y"), small_int(event, "buttons"), small_int(event, "client"));
   } else if (event.type == "client") {
@@ -104,7 +115,8 @@ void SessionReplay::apply_inputs() {
   const std::vector<sim::Event>& events = log_.events;
   for (; next_event_ < events.size() && events[next_event_].tick <= tick; ++next_event_) {
     const sim::Event& event = events[next_event_];
-    if (event.tick < tick && (event.type == "key" || event.type == "pointer" || event.type == "client")) {
+    if (event.tick < tick && (event.type == "key" || event.type == "pointer" || event.type == "client" ||
+                                  event.type == "robot_command")) {
       throw sim::SessionLogError((log_.dir / "events.jsonl").string() + ": a " + event.type + " event at tick " +
                                  std::to_string(event.tick) + " comes after events of tick " + std::to_string(tick) +
                                  ": events are not in tick order");

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+
 #include "config.hpp"
 #include "scratch_dir.hpp"
 
@@ -488,4 +490,116 @@ TEST_CASE("max_duration fits the offered scenarios' tasks unless the config sets
     CHECK(loaded.config.max_duration_set);
     CHECK_FALSE(load_config_file(dir.write("other.yaml", "max_sessions: 2\n"), ManagerConfig{}).config.max_duration_set);
   }
+}
+
+TEST_CASE("the ros section: a lab's rosbridge, its token and CA files, the namespace and the default control") {
+  ScratchDir dir;
+  const std::string token = dir.write("rosbridge.token", "lab-token-0123\n");
+  const std::string ca = dir.write("lab-ca.pem", "-----BEGIN CERTIFICATE-----\nMIIB\n-----END CERTIFICATE-----\n");
+  const ConfigOutcome outcome = load_config_file(dir.write("manager.yaml", "ros:\n"
+                                                                           "  connect: wss://ros.lab.example.org:9090/\n"
+                                                                           "  token_file: " + token + "\n"
+                                                                           "  ca_file: " + ca + "\n"
+                                                                           "  namespace: /lab/study_3\n"
+                                                                           "  robot_control: external\n"),
+                                                 ManagerConfig{});
+  REQUIRE(outcome.error.empty());
+  CHECK(outcome.config.ros.connect == "wss://ros.lab.example.org:9090/");
+  CHECK(outcome.config.ros.token_file == token);
+  CHECK(outcome.config.ros.ca_file == ca);
+  CHECK(outcome.config.ros.ros_namespace == "/lab/study_3");
+  CHECK(outcome.config.ros.robot_control == "external");
+  CHECK(validate_config(outcome.config).empty());
+  // The defaults: no ROS, /rfbsim, builtin.
+  const ManagerConfig defaults;
+  CHECK(defaults.ros.connect.empty());
+  CHECK(defaults.ros.token_file.empty());
+  CHECK(defaults.ros.ca_file.empty());
+  CHECK(defaults.ros.ros_namespace == "/rfbsim");
+  CHECK(defaults.ros.robot_control == "builtin");
+  // The same from flags, over the file.
+  const ConfigOutcome flags = parse_manager_args({"--ros-connect", "ws://127.0.0.1:9090", "--ros-namespace", "/x",
+                                                  "--ros-token-file", token, "--ros-robot-control", "external"});
+  REQUIRE(flags.error.empty());
+  CHECK(flags.config.ros.connect == "ws://127.0.0.1:9090");
+  CHECK(flags.config.ros.ros_namespace == "/x");
+  CHECK(flags.config.ros.token_file == token);
+  CHECK(flags.config.ros.robot_control == "external");
+  CHECK_THAT(manager_usage(), Contains("--ros-connect URL"));
+}
+
+TEST_CASE("the ros section's files are made absolute: a session runs in its own folder") {
+  ScratchDir dir;
+  dir.write("t.token", "abc\n");
+  const auto before = std::filesystem::current_path();
+  std::filesystem::current_path(dir.path());
+  const ConfigOutcome outcome = parse_manager_args({"--ros-connect", "ws://localhost:9090", "--ros-token-file", "t.token"});
+  std::filesystem::current_path(before);
+  REQUIRE(outcome.error.empty());
+  CHECK(outcome.config.ros.token_file == dir.path("t.token"));
+}
+
+TEST_CASE("a bad ros section says which key and why") {
+  ScratchDir dir;
+  const std::string token = dir.write("rosbridge.token", "lab-token\n");
+  const std::string yaml = dir.path("manager.yaml");
+  CHECK(file_error(dir, "ros:\n  connect: http://ros.lab/\n") ==
+        yaml + ":2: ros.connect: expected a ws:// or wss:// URL such as wss://ros.lab.example.org:9090/");
+  CHECK(file_error(dir, "ros:\n  connect: \"wss://ros lab/\"\n") ==
+        yaml + ":2: ros.connect: must not hold spaces or control characters");
+  CHECK(file_error(dir, "ros:\n  connect: wss://me:pw@ros.lab/\n") ==
+        yaml + ":2: ros.connect: must not hold user info (user@host): put the credential in token_file");
+  CHECK(file_error(dir, "ros:\n  connect: wss://ros.lab/\n  namespace: rfbsim\n") ==
+        yaml + ":3: ros.namespace: expected a ROS name such as /rfbsim: '/', then segments of letters, digits and "
+               "'_' that start with a letter, joined by '/', no '/' at the end");
+  CHECK(file_error(dir, "ros:\n  namespace: /rfbsim/\n") ==
+        yaml + ":2: ros.namespace: expected a ROS name such as /rfbsim: '/', then segments of letters, digits and "
+               "'_' that start with a letter, joined by '/', no '/' at the end");
+  CHECK(file_error(dir, "ros:\n  robot_control: planner\n") == yaml + ":2: ros.robot_control: expected builtin or external");
+  CHECK(file_error(dir, "ros:\n  token_file: " + dir.path("nope") + "\n") ==
+        yaml + ":2: ros.token_file: cannot read " + dir.path("nope"));
+  CHECK(file_error(dir, "ros:\n  ca_file: " + token + "\n") ==
+        yaml + ":2: ros.ca_file: " + token + " holds no PEM certificate (-----BEGIN CERTIFICATE-----)");
+  CHECK(file_error(dir, "ros:\n  port: 9090\n") ==
+        yaml + ":2: ros.port: unknown setting (known: connect, token_file, ca_file, namespace, robot_control, "
+               "cmd_vel_type)");
+  CHECK(file_error(dir, "ros:\n  cmd_vel_type: Twist\n") == yaml + ":2: ros.cmd_vel_type: expected twist or twist_stamped");
+  CHECK(file_error(dir, "ros: wss://ros.lab/\n") ==
+        yaml + ":1: ros: expected a mapping (connect, token_file, ca_file, namespace, robot_control, cmd_vel_type)");
+  CHECK(file_error(dir, "ros:\n  connect: [a, b]\n") == yaml + ":2: ros.connect: expected a single value");
+  CHECK(file_error(dir, "ros_connect: wss://ros.lab/\n") ==
+        yaml + ":1: ros_connect: unknown setting (write it as connect: under ros:)");
+  // A secret's file content never shows; its path does.
+  const std::string two_lines = dir.write("two.token", "secret-a\nsecret-b\n");
+  CHECK(file_error(dir, "ros:\n  token_file: " + two_lines + "\n").find("secret-") == std::string::npos);
+  CHECK(args_error({"--ros-robot-control", "maybe"}) == "--ros-robot-control 'maybe': expected builtin or external");
+  CHECK(args_error({"--ros-port", "9090"}) == "unknown option '--ros-port'");
+}
+
+TEST_CASE("ros settings that cannot work together") {
+  ScratchDir dir;
+  const std::string token = dir.write("rosbridge.token", "lab-token\n");
+  ManagerConfig c;
+  c.ros.robot_control = "external";
+  CHECK(validate_config(c) == "ros: robot_control external needs connect (the lab's rosbridge)");
+  c.ros.robot_control = "builtin";
+  c.ros.token_file = token;
+  CHECK(validate_config(c) == "ros: token_file and ca_file need connect");
+  // A Bearer token over plain ws:// crosses the network in clear, except on loopback.
+  c.ros.connect = "ws://ros.lab.example.org:9090/";
+  CHECK(validate_config(c) ==
+        "ros: token_file needs a wss:// connect: over ws:// the token would cross the network in clear");
+  for (const char* loopback : {"ws://127.0.0.1:9090", "ws://localhost/", "ws://[::1]:9090"}) {
+    c.ros.connect = loopback;
+    CHECK(validate_config(c).empty());
+  }
+  c.ros.token_file.clear();
+  c.ros.ca_file = "/etc/ca.pem";
+  CHECK(validate_config(c) == "ros: ca_file needs a wss:// connect");
+  c.ros.connect = "wss://ros.lab.example.org/";
+  CHECK(validate_config(c).empty());
+  c.session_kind = SessionKind::kRfb;
+  c.session_args = {"{port}"};
+  CHECK(validate_config(c) ==
+        "ros: needs session_kind sim_rfb (a legacy program's template may use {robot_control} itself)");
 }

@@ -232,3 +232,160 @@ TEST_CASE("the JSON escapes what it writes") {
   r.uid = "x\\y";
   CHECK(parameters_json(r, 0) == R"({"uid":"x\\y","scenario":"a\"b","seed":"0"})");
 }
+
+// --- ROS (issue 20): the link's robot_control and the config's ros section ---
+
+namespace {
+
+using rfbsim::manager::ros_request_problem;
+using rfbsim::manager::ScenarioFacts;
+using rfbsim::manager::session_ros;
+
+// A config offering "depot" (a robot), "hall" (no robot) and "lost" (no file found: no facts).
+ManagerConfig ros_config() {
+  ManagerConfig config;
+  config.scenarios = {"depot", "hall", "lost"};
+  ScenarioFacts depot;
+  depot.name = "depot";
+  depot.has_robot = true;
+  ScenarioFacts hall;
+  hall.name = "hall";
+  config.scenario_facts = {depot, hall};
+  return config;
+}
+
+// The arguments after --seed N and before --proxy-protocol: the overrides and ROS's flags.
+Args middle(const Args& args) {
+  const auto seed = std::find(args.begin(), args.end(), "--seed");
+  REQUIRE(std::distance(seed, args.end()) >= 2);
+  const auto proxy = std::find(seed + 2, args.end(), "--proxy-protocol");
+  REQUIRE(proxy != args.end());
+  return Args(seed + 2, proxy);
+}
+
+}  // namespace
+
+TEST_CASE("the link's robot_control reaches sim_rfb as --robot-control, with or without ROS") {
+  ManagerConfig config = ros_config();
+  StartRequest r = request("depot");
+  r.overrides = {{"robot_goal", "dock"}, {"robot_control", "builtin"}};
+  const LaunchContext context{7, 0, "/data/p01-1", "", 12};
+  CHECK(middle(session_arguments(config, r, context)) == Args{"--robot-goal", "dock", "--robot-control", "builtin"});
+  CHECK(parameters_json(r, 7) ==
+        R"({"uid":"p01","scenario":"depot","seed":"7","robot_goal":"dock","robot_control":"builtin"})");
+  // Without a ros section nothing else is added, and a link without the setting is as before.
+  CHECK(middle(session_arguments(config, request("depot"), context)).empty());
+  CHECK(session_ros(config, request("depot"), 12).robot_control == "builtin");
+  CHECK(session_ros(config, request("depot"), 12).ros_namespace.empty());
+  CHECK(session_ros(config, request("hall"), 12).robot_control.empty());
+}
+
+TEST_CASE("with a ros section a robot scenario's session dials out to the lab under its own namespace") {
+  ManagerConfig config = ros_config();
+  config.ros.connect = "wss://ros.lab.example.org:9090/";
+  config.ros.token_file = "/etc/rfbsim/rosbridge.token";
+  config.ros.ca_file = "/etc/rfbsim/lab-ca.pem";
+  config.ros.robot_control = "external";
+  const LaunchContext context{7, 0, "/data/p01-12", "", 12};
+  const Args args = session_arguments(config, request("depot"), context);
+  CHECK(middle(args) == Args{"--robot-control", "external", "--rosbridge-connect", "wss://ros.lab.example.org:9090/",
+                             "--ros-namespace", "/rfbsim/s_12", "--cmd-vel-type", "twist", "--rosbridge-token-file",
+                             "/etc/rfbsim/rosbridge.token", "--rosbridge-ca", "/etc/rfbsim/lab-ca.pem"});
+  // Never sim_rfb's own rosbridge port: it has no authentication.
+  CHECK(std::find(args.begin(), args.end(), "--rosbridge-port") == args.end());
+  CHECK(std::find(args.begin(), args.end(), "--rosbridge-bind") == args.end());
+  const auto ros = session_ros(config, request("depot"), 12);
+  CHECK(ros.ros_namespace == "/rfbsim/s_12");
+  CHECK(ros.robot_control == "external");
+
+  // The link's robot_control wins over the section's default, and is given once.
+  StartRequest r = request("depot");
+  r.overrides = {{"robot_control", "builtin"}};
+  const Args chosen = session_arguments(config, r, context);
+  CHECK(std::count(chosen.begin(), chosen.end(), "--robot-control") == 1);
+  CHECK(middle(chosen).at(1) == "builtin");
+  CHECK(session_ros(config, r, 12).robot_control == "builtin");
+
+  // Without optional files, only the connection and the namespace; the default control is builtin.
+  config.ros.token_file.clear();
+  config.ros.ca_file.clear();
+  config.ros.robot_control = "builtin";
+  config.ros.ros_namespace = "/lab/study_3";
+  config.ros.cmd_vel_type = "twist_stamped";
+  CHECK(middle(session_arguments(config, request("depot"), {7, 0, "/d", "", 3})) ==
+        Args{"--robot-control", "builtin", "--rosbridge-connect", "wss://ros.lab.example.org:9090/", "--ros-namespace",
+             "/lab/study_3/s_3", "--cmd-vel-type", "twist_stamped"});
+}
+
+TEST_CASE("a scenario without a robot, or one whose file was not found, gets no ROS") {
+  ManagerConfig config = ros_config();
+  config.ros.connect = "ws://127.0.0.1:9090";
+  config.ros.robot_control = "external";
+  for (const char* scenario : {"hall", "lost"}) {
+    INFO(scenario);
+    CHECK(middle(session_arguments(config, request(scenario), {7, 0, "/d", "", 5})).empty());
+    CHECK(session_ros(config, request(scenario), 5).ros_namespace.empty());
+    CHECK(session_ros(config, request(scenario), 5).robot_control.empty());
+  }
+}
+
+TEST_CASE("in a cluster a session's ROS name carries its host, whose ids number sessions each from 1") {
+  ManagerConfig config = ros_config();
+  config.ros.connect = "wss://ros.lab.example.org/";
+  config.host_id = "h-2";
+  CHECK(session_ros(config, request("depot"), 12).ros_namespace == "/rfbsim/s_12");
+  config.cluster_peers = {{"h-1", "10.0.0.1", 7000}, {"h-2", "10.0.0.2", 7000}, {"h3", "10.0.0.3", 7000}};
+  CHECK(session_ros(config, request("depot"), 12).ros_namespace == "/rfbsim/s_12_h_2");
+}
+
+TEST_CASE("a link asking for external control is refused where nothing would drive the robot") {
+  ManagerConfig config = ros_config();
+  StartRequest r = request("depot");
+  r.overrides = {{"robot_control", "external"}};
+  CHECK(ros_request_problem(config, r) ==
+        "robot_control external is not offered here: this server has no connection to a lab's ROS (ros.connect), so "
+        "nothing would drive the robot");
+  config.ros.connect = "wss://ros.lab.example.org/";
+  CHECK(ros_request_problem(config, r).empty());
+  r.scenario = "lost";
+  CHECK(ros_request_problem(config, r) ==
+        "robot_control external is not offered for scenario lost: sim_manager did not find its file, so it cannot "
+        "tell whether it has a robot");
+  // builtin, or no setting, is always fine.
+  r.overrides = {{"robot_control", "builtin"}};
+  CHECK(ros_request_problem(config, r).empty());
+  CHECK(ros_request_problem(ros_config(), request("depot")).empty());
+  // A legacy program's template takes the value as it is.
+  ManagerConfig legacy;
+  legacy.session_kind = SessionKind::kRfb;
+  r.overrides = {{"robot_control", "external"}};
+  CHECK(ros_request_problem(legacy, r).empty());
+}
+
+TEST_CASE("an rfb program gets the link's robot_control as {robot_control}") {
+  ManagerConfig config;
+  config.session_kind = SessionKind::kRfb;
+  config.session_args = {"--port={port}", "--control={robot_control}"};
+  StartRequest r = request("lab");
+  r.overrides = {{"robot_control", "external"}};
+  CHECK(session_arguments(config, r, {1, 5900, "/d", "", 1}) == Args{"--port=5900", "--control=external"});
+  CHECK(session_arguments(config, request("lab"), {1, 5900, "/d", "", 1}) == Args{"--port=5900", "--control="});
+}
+
+TEST_CASE("session_args may not open sim_rfb's rosbridge server nor set ROS's flags") {
+  using rfbsim::manager::session_args_problem;
+  CHECK(session_args_problem({"--rosbridge-port", "9090"}, SessionKind::kSimRfb) ==
+        "session_args: --rosbridge-port cannot be given there: sim_rfb's rosbridge server has no authentication, so "
+        "any local user could drive the robot (use ros.connect: each session dials out to the lab)");
+  CHECK(session_args_problem({"--rosbridge-bind=0.0.0.0"}, SessionKind::kSimRfb) ==
+        "session_args: --rosbridge-bind cannot be given there: sim_rfb's rosbridge server has no authentication, so "
+        "any local user could drive the robot (use ros.connect: each session dials out to the lab)");
+  CHECK(session_args_problem({"--rosbridge-connect", "ws://x"}, SessionKind::kSimRfb) ==
+        "session_args: --rosbridge-connect is set by sim_manager from the ros section and cannot be given there");
+  CHECK(session_args_problem({"--robot-control", "external"}, SessionKind::kSimRfb) ==
+        "session_args: --robot-control is set by sim_manager from the link's robot_control or ros.robot_control and "
+        "cannot be given there");
+  for (const char* flag : {"--rosbridge-token-file", "--rosbridge-ca", "--ros-namespace"}) {
+    CHECK_FALSE(session_args_problem({flag, "x"}, SessionKind::kSimRfb).empty());
+  }
+}

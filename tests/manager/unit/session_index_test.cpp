@@ -364,3 +364,53 @@ TEST_CASE("an index made before the address hash gains its column, empty for the
   next.id = reopened.insert(next);
   CHECK(reopened.find_by_token(next.token)->address_hash == "00112233aabbccdd");
 }
+
+TEST_CASE("a session's ROS namespace and robot control are written with the row and read back") {
+  ScratchDir dir;
+  const std::string path = dir.path("sessions.db");
+  SessionIndex index(path);
+  Session s = make("p01");
+  s.ros_namespace = "/rfbsim/s_1";
+  s.robot_control = "external";
+  s.id = index.insert(s);
+  s.state = SessionState::kRunning;
+  index.update(s);
+  const auto back = index.find_by_token(s.token);
+  REQUIRE(back);
+  CHECK(back->ros_namespace == "/rfbsim/s_1");
+  CHECK(back->robot_control == "external");
+  CHECK(sql_text(path, "SELECT ros_namespace || ' ' || robot_control FROM sessions WHERE id = 1") ==
+        "/rfbsim/s_1 external");
+  // Without ROS or a robot: ''.
+  index.insert(make("p02"));
+  CHECK(sql_text(path, "SELECT ros_namespace || robot_control FROM sessions WHERE id = 2").empty());
+}
+
+TEST_CASE("an index made before ROS gains its columns, empty for the sessions it holds") {
+  ScratchDir dir;
+  const std::string path = dir.path("sessions.db");
+  const Session old = make("p01");
+  {
+    SessionIndex index(path);
+    index.insert(old);
+  }
+  // The table as the manager before issue 20 left it.
+  sql_text(path, "ALTER TABLE sessions DROP COLUMN ros_namespace");
+  sql_text(path, "ALTER TABLE sessions DROP COLUMN robot_control");
+  REQUIRE(sql_text(path, "SELECT COUNT(*) FROM pragma_table_info('sessions') WHERE name LIKE 'ro%'") == "0");
+  SessionIndex reopened(path);
+  CHECK(sql_text(path, "SELECT COUNT(*) FROM pragma_table_info('sessions') WHERE name IN ('ros_namespace', "
+                       "'robot_control')") == "2");
+  const auto back = reopened.find_by_token(old.token);
+  REQUIRE(back);
+  CHECK(back->ros_namespace.empty());
+  CHECK(back->robot_control.empty());
+  Session next = make("p02");
+  next.ros_namespace = "/lab/s_2";
+  next.robot_control = "builtin";
+  reopened.insert(next);
+  const auto again = reopened.find_by_token(next.token);
+  REQUIRE(again);
+  CHECK(again->ros_namespace == "/lab/s_2");
+  CHECK(again->robot_control == "builtin");
+}

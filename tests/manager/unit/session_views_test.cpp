@@ -88,7 +88,8 @@ TEST_CASE("the admin API's session JSON names every field, and the token only wh
       R"("exit_status":"","created_at":"2026-11-24T10:00:00.000Z","ready_at":"2026-11-24T10:00:00.250Z",)"
       R"("ended_at":null,"data_path":"/data/sessions/7-p-01","outcome":null,)"
       R"("copy_state":"","copy_attempts":0,"copy_error":"",)"
-      R"("params":{"uid":"p-01","scenario":"lab","seed":"42"},"codec":null,"rtt_ms":null,"fps":null)";
+      R"("params":{"uid":"p-01","scenario":"lab","seed":"42"},"ros_namespace":null,"robot_control":null,)"
+      R"("codec":null,"rtt_ms":null,"fps":null)";
   CHECK(rfbsim::manager::session_json(s, false) == expected + "}");
   CHECK(rfbsim::manager::session_json(s, true) == expected + R"(,"token":"0123456789abcdef0123456789abcdef"})");
 }
@@ -125,7 +126,8 @@ TEST_CASE("the session record beside the data says how the session ended, with n
         "{\"id\":7,\"uid\":\"p\\\"1\",\"host\":\"h2\",\"address_hash\":null,\"state\":\"abandoned\","
         "\"detail\":\"no browser connected for 60 s\","
         "\"created_at\":\"2023-11-14T22:13:20.000Z\",\"ready_at\":null,\"spent_at\":null,"
-        "\"ended_at\":\"2023-11-14T22:14:21.000Z\",\"outcome\":null,\"data_incomplete\":null}\n");
+        "\"ended_at\":\"2023-11-14T22:14:21.000Z\",\"outcome\":null,\"data_incomplete\":null,"
+        "\"ros_namespace\":null,\"robot_control\":null}\n");
   session.spent_at = session.created + std::chrono::milliseconds(1500);
   session.data_incomplete = "events.jsonl: cannot write (No space left on device)";
   session.address_hash = "0123456789abcdef";
@@ -134,4 +136,24 @@ TEST_CASE("the session record beside the data says how the session ended, with n
   CHECK(with.find("\"data_incomplete\":\"events.jsonl: cannot write (No space left on device)\"") != std::string::npos);
   CHECK(with.find("\"host\":\"h2\",\"address_hash\":\"0123456789abcdef\",") != std::string::npos);
   CHECK(with.find(session.token) == std::string::npos);
+}
+
+TEST_CASE("the researcher sees a session's ROS namespace and robot control, the participant's poll does not") {
+  Session s = sample();
+  s.ros_namespace = "/rfbsim/s_7";
+  s.robot_control = "external";
+  const std::string admin = rfbsim::manager::session_json(s, false);
+  CHECK(admin.find(R"("ros_namespace":"/rfbsim/s_7","robot_control":"external",)") != std::string::npos);
+  CHECK(rfbsim::manager::session_record_json(s).find(R"("ros_namespace":"/rfbsim/s_7","robot_control":"external"})") !=
+        std::string::npos);
+  // The participant's page is told nothing of the lab's ROS.
+  const std::string status = rfbsim::manager::status_json(s, s.created, {});
+  CHECK(status.find("ros") == std::string::npos);
+  CHECK(status.find("robot") == std::string::npos);
+  CHECK(status.find("rfbsim/s_7") == std::string::npos);
+  // A robot driven by the simulator, no ROS.
+  s.ros_namespace.clear();
+  s.robot_control = "builtin";
+  CHECK(rfbsim::manager::session_json(s, false).find(R"("ros_namespace":null,"robot_control":"builtin",)") !=
+        std::string::npos);
 }

@@ -87,7 +87,7 @@ TEST_CASE("overrides come out in the order of kOverrideParams whatever the link'
 }
 
 TEST_CASE("the override parameters and their sim_rfb flags") {
-  REQUIRE(kOverrideParams.size() == 5);
+  REQUIRE(kOverrideParams.size() == 6);
   CHECK(std::string(kOverrideParams[0].name) == "avatar_start");
   CHECK(std::string(kOverrideParams[0].flag) == "--avatar-start");
   CHECK(std::string(kOverrideParams[1].name) == "avatar_goal");
@@ -98,6 +98,27 @@ TEST_CASE("the override parameters and their sim_rfb flags") {
   CHECK(std::string(kOverrideParams[3].flag) == "--robot-goal");
   CHECK(std::string(kOverrideParams[4].name) == "crowd");
   CHECK(std::string(kOverrideParams[4].flag) == "--crowd");
+  CHECK(std::string(kOverrideParams[5].name) == "robot_control");
+  CHECK(std::string(kOverrideParams[5].flag) == "--robot-control");
+}
+
+TEST_CASE("robot_control is builtin or external, exactly") {
+  for (const char* value : {"builtin", "external"}) {
+    const StartParse parsed = parse_with("robot_control", value);
+    REQUIRE(parsed.request);
+    CHECK(parsed.request->overrides == std::vector<std::pair<std::string, std::string>>{{"robot_control", value}});
+  }
+  for (const char* value : {"", "External", "extern", "builtin ", "dock", "1,2,0", "external,builtin"}) {
+    INFO(value);
+    CHECK(parse_with("robot_control", value).error ==
+          "robot_control '" + std::string(value) + "' is not valid: use builtin or external");
+  }
+  // Last in the fixed order, whatever the link's order.
+  const StartParse parsed =
+      parse_start_request({{"uid", "p01"}, {"robot_control", "external"}, {"crowd", "3"}}, kScenarios);
+  REQUIRE(parsed.request);
+  CHECK(parsed.request->overrides ==
+        std::vector<std::pair<std::string, std::string>>{{"crowd", "3"}, {"robot_control", "external"}});
 }
 
 TEST_CASE("sig is ignored by the request check") {
@@ -468,5 +489,17 @@ TEST_CASE("a link naming a spawn point its scenario lacks is refused, before any
         "avatar_start 'dock' is not a spawn point of bare (known: none; or give x,y,yaw)");
   CHECK(parse_start_request({{"uid", "p01"}, {"robot_goal", "1,2,0"}}, {"bare"}, bare_facts).error ==
         "robot_goal is not valid here: scenario bare has no robot");
+  CHECK(parse_start_request({{"uid", "p01"}, {"robot_control", "external"}}, {"bare"}, bare_facts).error ==
+        "robot_control is not valid here: scenario bare has no robot");
   CHECK(parse_start_request({{"uid", "p01"}, {"avatar_start", "1,2,0"}}, {"bare"}, bare_facts).request);
+}
+
+TEST_CASE("robot_control on a scenario with a robot is a mode, not a spawn point") {
+  const std::vector<ScenarioFacts> facts = {depot_facts()};
+  for (const char* value : {"builtin", "external"}) {
+    const StartParse parsed = parse_start_request({{"uid", "p01"}, {"robot_control", value}}, {"depot"}, facts);
+    INFO(parsed.error);
+    REQUIRE(parsed.request);
+    CHECK(parsed.request->overrides == std::vector<std::pair<std::string, std::string>>{{"robot_control", value}});
+  }
 }
