@@ -89,7 +89,9 @@ SessionRos session_ros(const ManagerConfig& config, const StartRequest& request,
   // the manager did not find is left as it was.
   if (facts == config.scenario_facts.end() || !facts->has_robot) return ros;
   const bool dials_out = !config.ros.connect.empty();
-  if (ros.robot_control.empty()) ros.robot_control = dials_out ? config.ros.robot_control : "builtin";
+  // The link's choice, else the ros section's, else the scenario's own `robot.control`.
+  if (ros.robot_control.empty()) ros.robot_control = dials_out ? config.ros.robot_control : "";
+  if (ros.robot_control.empty()) ros.robot_control = facts->robot_control;
   if (dials_out) {
     // Hosts of a cluster number their sessions each from 1, and may share one lab: their names carry the host.
     const std::string host = config.cluster_peers.empty() ? std::string() : config.host_id;
@@ -104,6 +106,12 @@ std::string ros_request_problem(const ManagerConfig& config, const StartRequest&
   const bool asked = std::any_of(request.overrides.begin(), request.overrides.end(), [](const auto& override_) {
     return override_.first == "robot_control" && override_.second == "external";
   });
+  // A scenario whose own robot.control is external, on a server that does not dial out: nothing would drive it.
+  if (!asked && ros.robot_control == "external" && ros.ros_namespace.empty()) {
+    return "scenario " + request.scenario + " puts its robot under external control (robot.control), but this "
+           "server has no connection to a lab's ROS (ros.connect), so nothing would drive it; give the link "
+           "robot_control=builtin, or configure ros:";
+  }
   if (!asked || !ros.ros_namespace.empty()) return "";
   if (config.ros.connect.empty()) {
     return "robot_control external is not offered here: this server has no connection to a lab's ROS (ros.connect), "

@@ -22,9 +22,9 @@ struct RosSettings {
   std::string token_file;  ///< absolute path of a file holding a Bearer token for the dial-out; "" = none
   std::string ca_file;     ///< absolute path of extra PEM CA certificates for wss; "" = the system's only
   std::string ros_namespace = "/rfbsim";  ///< a ROS name; each session's topics go under <namespace>/<session>
-  /// Who drives the robot where a link does not say: "builtin" (the simulator's own planner) or "external"
-  /// (/cmd_vel from the lab's stack).
-  std::string robot_control = "builtin";
+  /// Who drives the robot where a link does not say: "builtin" (the simulator's own planner), "external"
+  /// (/cmd_vel from the lab's stack), or "" = what the scenario's `robot.control` says (builtin when it says nothing).
+  std::string robot_control;
   /// The type of the lab's /cmd_vel: "twist" (geometry_msgs/msg/Twist) or "twist_stamped" (Jazzy-era stacks).
   std::string cmd_vel_type = "twist";
 };

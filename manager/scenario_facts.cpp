@@ -81,6 +81,10 @@ std::optional<ScenarioFacts> parse_scenario_facts(const std::string& text, const
     }
   }
   facts.has_robot = static_cast<bool>(root["robot"]);
+  if (facts.has_robot && root["robot"].IsMap()) {
+    const YAML::Node control = root["robot"]["control"];
+    if (control && control.IsScalar() && control.Scalar() == "external") facts.robot_control = "external";
+  }
   if (const YAML::Node task = root["task"]) {
     if (!task.IsMap()) {
       error = where(file, task, "task") + "expected a mapping (time_limit, end_grace, steps)";

@@ -19,6 +19,9 @@ struct ScenarioFacts {
   std::string file;                 ///< the file read
   std::vector<std::string> spawns;  ///< `spawns`: the spawn points' names, in file order
   bool has_robot = false;           ///< the file has a `robot` (robot_start and robot_goal need one)
+  /// `robot.control`: who drives the robot unless a link or the ros section says otherwise ("builtin" or
+  /// "external"; a value sim_rfb would refuse reads as builtin here, and sim_rfb says what is wrong).
+  std::string robot_control = "builtin";
   bool has_task = false;            ///< the file has a `task`: a clock, an outcome and an end
   double time_limit_s = 240.0;      ///< `task.time_limit`, s (sim_rfb's default, SEAN-EP's 4 min timer)
   double end_grace_s = 15.0;        ///< `task.end_grace`, s (sim_rfb's default)

@@ -27,6 +27,7 @@
 #include "app/frame_painter.hpp"
 #include "app/options.hpp"
 #include "app/ros_link.hpp"
+#include "app/ros_setup.hpp"
 #include "app/session_setup.hpp"
 #include "app/simulation.hpp"
 #include "app/stream_status.hpp"
@@ -239,65 +240,6 @@ rfbsim::sim::SessionWriterOptions writer_options_from_environment() {
   return options;
 }
 
-// The dial-out token: the file's first line. Throws std::runtime_error when it cannot be read or is empty; warns
-// when others may read it (it authenticates this study's robot to the lab's ROS).
-std::string read_token_file(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::is_regular_file(status)) {
-    throw std::runtime_error("--rosbridge-token-file " + path + ": not a readable file");
-  }
-  using std::filesystem::perms;
-  if ((status.permissions() & (perms::group_read | perms::others_read)) != perms::none) {
-    std::fprintf(stderr, "[ros] warning: %s can be read by other users; chmod 600 it\n", path.c_str());
-  }
-  std::FILE* file = std::fopen(path.c_str(), "r");
-  if (file == nullptr) throw std::runtime_error("--rosbridge-token-file " + path + ": " + std::strerror(errno));
-  char line[1024] = {};
-  const bool read = std::fgets(line, sizeof line, file) != nullptr;
-  std::fclose(file);
-  std::string token = read ? line : "";
-  while (!token.empty() && (token.back() == '\n' || token.back() == '\r' || token.back() == ' ')) token.pop_back();
-  const bool printable = std::all_of(token.begin(), token.end(), [](unsigned char c) { return c > 0x20 && c < 0x7f; });
-  if (token.empty() || !printable) {
-    throw std::runtime_error("--rosbridge-token-file " + path + ": the first line must hold the token (printable, no spaces)");
-  }
-  return token;
-}
-
-// The ROS side, when asked for: a bag beside the session data and/or a rosbridge server or client. The bag
-// goes in the data folder, which is made here, before the session's own files.
-std::unique_ptr<rfbsim::sim::RosLink> open_ros_link(const rfbsim::sim::SimOptions& options) {
-  const bool bag = !options.data_dir.empty() && options.mcap;
-  if (!bag && !options.rosbridge_port && options.rosbridge_connect.empty()) return nullptr;
-  rfbsim::sim::RosLinkOptions ros;
-  if (bag) {
-    // SessionWriter refuses a folder that holds a session; refuse it here first, before a bag lands in it.
-    if (std::filesystem::exists(std::filesystem::path(options.data_dir) / "session.json")) {
-      throw std::runtime_error(options.data_dir + " already holds a session (session.json); give a new folder");
-    }
-    std::filesystem::create_directories(options.data_dir);
-    ros.bag_file = std::filesystem::path(options.data_dir) / "session.mcap";
-  }
-  ros.server_port = options.rosbridge_port;
-  ros.server_bind = options.rosbridge_bind;
-  ros.connect_url = options.rosbridge_connect;
-  if (!options.rosbridge_token_file.empty()) ros.token = read_token_file(options.rosbridge_token_file);
-  ros.ca_file = options.rosbridge_ca;
-  ros.topic_namespace = options.ros_namespace;
-  ros.cmd_vel_type = options.cmd_vel_type;
-  ros.tick_hz = options.tick_hz;
-  auto link = std::make_unique<rfbsim::sim::RosLink>(std::move(ros));
-  if (const auto port = link->server_port()) {
-    std::fprintf(stderr, "[ros] rosbridge v2 server on ws://%s:%d/ (unauthenticated: keep it on loopback)\n",
-                 options.rosbridge_bind.c_str(), *port);
-  }
-  if (!options.rosbridge_connect.empty()) {
-    std::fprintf(stderr, "[ros] rosbridge client dialling %s\n", options.rosbridge_connect.c_str());
-  }
-  return link;
-}
-
 int run(const rfbsim::sim::SimOptions& options) {
   using Clock = std::chrono::steady_clock;
   namespace sim = rfbsim::sim;
@@ -311,7 +253,7 @@ int run(const rfbsim::sim::SimOptions& options) {
                  prepared.info.scenario_file.c_str(), static_cast<unsigned long long>(prepared.info.seed),
                  simulation.world().people.size());
   }
-  std::unique_ptr<sim::RosLink> ros_link = open_ros_link(options);
+  std::unique_ptr<sim::RosLink> ros_link = sim::open_ros_link(options);
   const sim::RobotStack* robot_stack = simulation.robot_stack();
   if (robot_stack && robot_stack->control() == sim::RobotControl::kExternal && !options.rosbridge_port &&
       options.rosbridge_connect.empty()) {
@@ -338,7 +280,9 @@ int run(const rfbsim::sim::SimOptions& options) {
     writer = std::make_unique<sim::SessionWriter>(options.data_dir, std::move(info), simulation.world(),
                                                   writer_options_from_environment());
     // The study's events also go to ROS's /events, and into the bag.
-    if (ros_link) writer->set_event_listener([&ros_link](std::uint64_t tick, const std::string& line) { ros_link->event(tick, line); });
+    if (ros_link) {
+      writer->set_event_listener([&ros_link](std::uint64_t tick, const std::string& line) { ros_link->event(tick, line); });
+    }
   }
   if (ros_link) ros_link->sample(simulation.world(), simulation.robot_stack());  // tick 0: /map, the scene, the start
   sim::StudySession study(simulation, prepared.task, {options.code_success, options.code_timeout}, writer.get());
@@ -416,7 +360,10 @@ int run(const rfbsim::sim::SimOptions& options) {
   status.publish(sim::status_json(simulation.world(), 0, 0));
   // The parent's line first: if it cannot be told, we are not ready, and stdout should not say we are.
   if (options.ready_fd) report_ready(*options.ready_fd, server);
-  if (ros_link && ros_link->server_port()) std::printf("sim_rfb rosbridge: ws://%s:%d/\n", options.rosbridge_bind.c_str(), *ros_link->server_port());
+  if (ros_link && ros_link->server_port()) {
+    std::printf("sim_rfb rosbridge: ws://%s:%d/\n", sim::url_host(options.rosbridge_bind).c_str(),
+                *ros_link->server_port());
+  }
   std::printf("sim_rfb ready: %s\n", server.url().c_str());
   std::fflush(stdout);
 
@@ -462,6 +409,9 @@ int run(const rfbsim::sim::SimOptions& options) {
                                           "(start the session with robot_control external)");
         }
       }
+      // A bag that stopped (a full disk) is told once, in the log (session.log under sim_manager). It is not the
+      // parent's "data incomplete", which is about the files the study's tables come from (trajectories.csv,
+      // events.jsonl): those may well go on while the larger bag cannot.
       if (const auto failure = ros_link->bag_failure(); failure && !bag_failure_told) {
         bag_failure_told = true;
         std::fprintf(stderr, "[ros] session.mcap stopped growing: %s (the session and its other files go on)\n",

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include <nlohmann/json.hpp>
+
 #include "ros/bridge/rosbridge_client.hpp"
 #include "ros/bridge/rosbridge_hub.hpp"
 #include "ros/bridge/rosbridge_server.hpp"
@@ -113,6 +115,17 @@ void RosLink::sample(const World& world, const RobotStack* robot) {
 void RosLink::event(std::uint64_t tick, const std::string& json_line) {
   if (impl_->finished) return;
   impl_->due.clear();
+  // A viewer's hashed address stays in events.jsonl on this server: /events may go to a lab's ROS graph, and the
+  // hash would let it link one participant's sessions.
+  if (json_line.find("\"address\"") != std::string::npos) {
+    nlohmann::ordered_json event = nlohmann::ordered_json::parse(json_line, nullptr, false);
+    if (event.is_object()) {
+      event.erase("address");
+      impl_->sampler.add_event(ros::tick_time_ns(tick, impl_->options.tick_hz), event.dump(), impl_->due);
+      impl_->hand_out(impl_->due);
+      return;
+    }
+  }
   impl_->sampler.add_event(ros::tick_time_ns(tick, impl_->options.tick_hz), json_line, impl_->due);
   impl_->hand_out(impl_->due);
 }
@@ -147,14 +160,16 @@ void RosLink::flush_if_due() {
 void RosLink::finish() {
   if (impl_->finished) return;
   impl_->finished = true;
-  impl_->client.reset();
-  impl_->server.reset();
+  // The bag first: every message is in it already, and the bridge's goodbyes (up to a second each, more when a
+  // lab is unreachable) must not spend the time sim_manager gives a session between SIGTERM and SIGKILL.
   if (impl_->bag) {
     impl_->bag->finish();
     if (const auto failure = impl_->bag->failure()) {
       std::fprintf(stderr, "[ros] session.mcap is incomplete: %s\n", failure->c_str());
     }
   }
+  impl_->client.reset();
+  impl_->server.reset();
 }
 
 std::optional<int> RosLink::server_port() const {
@@ -169,9 +184,13 @@ std::optional<std::string> RosLink::bag_failure() const {
 
 std::string RosLink::bridge_description() const {
   std::string text;
-  if (impl_->server) text = "server " + impl_->options.server_bind + ":" + std::to_string(impl_->server->port());
+  if (impl_->server) text = "server " + url_host(impl_->options.server_bind) + ":" + std::to_string(impl_->server->port());
   if (impl_->client) text += (text.empty() ? "" : " + ") + std::string("client ") + impl_->options.connect_url;
   return text;
+}
+
+std::string url_host(const std::string& address) {
+  return address.find(':') != std::string::npos ? "[" + address + "]" : address;
 }
 
 }  // namespace rfbsim::sim

@@ -37,7 +37,7 @@ struct RobotCommand {
   double v = 0.0;          ///< m/s
   double w = 0.0;          ///< rad/s
   std::string source;      ///< "rosbridge" (a client of our server) or "rosbridge-client" (the lab's server)
-  int connection = 0;      ///< which server connection sent it (0 for the dial-out)
+  int connection = 0;      ///< the hub's id of the connection that sent it (the dial-out has one too)
 };
 
 class RosLink {
@@ -67,12 +67,16 @@ class RosLink {
   [[nodiscard]] std::optional<int> server_port() const;
   /// Why the bag stopped being written (a full disk), if it did.
   [[nodiscard]] std::optional<std::string> bag_failure() const;
-  /// "server 127.0.0.1:9090", "client wss://...", "server ... + client ..." or "" (for session.json).
+  /// "server 127.0.0.1:9090" ("server [::1]:9090"), "client wss://...", "server ... + client ..." or "" (for
+  /// session.json).
   [[nodiscard]] std::string bridge_description() const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// A numeric address as a URL's host: an IPv6 one in brackets ("[::1]"), any other as it is.
+std::string url_host(const std::string& address);
 
 }  // namespace rfbsim::sim

@@ -119,7 +119,10 @@ void RobotStack::step(World& world, double dt) {
     mission_started_ = true;
     next_mission_goal(world);
   }
-  if (setup_.control == RobotControl::kExternal) watch_external_commands(world);
+  if (setup_.control == RobotControl::kExternal) {
+    watch_external_commands(world);
+    external_goal_reached(world);
+  }
 
   // Sense: the wheels count every tick; the lidar sweeps at its own rate, from the true pose.
   odometry_.update(robot.pose);
@@ -247,6 +250,7 @@ void RobotStack::next_mission_goal(World& world) {
     if (setup_.control == RobotControl::kExternal) {
       // The controller outside is told the goal (ROS's /goal_pose); reaching it is its business.
       world.robot->nav.goal = *goal;
+      goal_finished_ = false;
       return;
     }
     goal_finished_ = false;
@@ -304,6 +308,19 @@ void RobotStack::watch_external_commands(World& world) {
     std::snprintf(detail, sizeof detail, "external control: no command for %.2f s, stopped", setup_.command_timeout);
     world.robot_events.push_back({world.tick, RobotState::Idle, detail});
     command_drive(0.0, 0.0, world.time);
+  }
+}
+
+// Under external control the mission still moves on: once the robot's centre is within the navigator's goal
+// tolerance of the goal, a patrol or a wander gives the next waypoint after its pause, so /goal_pose follows.
+void RobotStack::external_goal_reached(World& world) {
+  if (!mission_goal_ || goal_finished_ || resume_mission_at_ >= 0.0) return;
+  const Pose2& at = world.robot->pose;
+  if (std::hypot(at.x - mission_goal_->x, at.y - mission_goal_->y) > setup_.params.navigator.xy_goal_tolerance) return;
+  goal_finished_ = true;
+  const auto kind = mission_.spec().kind;
+  if (kind == MissionSpec::Kind::Patrol || kind == MissionSpec::Kind::Wander) {
+    resume_mission_at_ = world.time + setup_.params.navigator.waypoint_pause;
   }
 }
 

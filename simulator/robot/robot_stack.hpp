@@ -111,6 +111,7 @@ class RobotStack {
   void command_drive(double v, double w, double now);
   void external_cycle(World& world);
   void watch_external_commands(World& world);
+  void external_goal_reached(World& world);
 
   RobotSetup setup_;
   DiffDrive drive_;

@@ -516,7 +516,7 @@ TEST_CASE("the ros section: a lab's rosbridge, its token and CA files, the names
   CHECK(defaults.ros.token_file.empty());
   CHECK(defaults.ros.ca_file.empty());
   CHECK(defaults.ros.ros_namespace == "/rfbsim");
-  CHECK(defaults.ros.robot_control == "builtin");
+  CHECK(defaults.ros.robot_control.empty());  // the scenario's own robot.control
   // The same from flags, over the file.
   const ConfigOutcome flags = parse_manager_args({"--ros-connect", "ws://127.0.0.1:9090", "--ros-namespace", "/x",
                                                   "--ros-token-file", token, "--ros-robot-control", "external"});

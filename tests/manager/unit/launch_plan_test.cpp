@@ -362,6 +362,34 @@ TEST_CASE("a link asking for external control is refused where nothing would dri
   CHECK(ros_request_problem(legacy, r).empty());
 }
 
+TEST_CASE("a scenario's own robot.control is the default, and is refused where nothing would drive the robot") {
+  ManagerConfig config = ros_config();
+  ScenarioFacts drone;
+  drone.name = "drone";
+  drone.has_robot = true;
+  drone.robot_control = "external";
+  config.scenarios.push_back("drone");
+  config.scenario_facts.push_back(drone);
+  // No ros section: a link that says nothing would start a robot nobody can drive; builtin is fine.
+  CHECK(ros_request_problem(config, request("drone")).find("puts its robot under external control") != std::string::npos);
+  StartRequest builtin = request("drone");
+  builtin.overrides = {{"robot_control", "builtin"}};
+  CHECK(ros_request_problem(config, builtin).empty());
+  CHECK(session_ros(config, builtin, 3).robot_control == "builtin");
+  // With a ros section that leaves control to the scenarios, the scenario's external reaches sim_rfb.
+  config.ros.connect = "wss://ros.lab.example.org:9090/";
+  CHECK(ros_request_problem(config, request("drone")).empty());
+  CHECK(session_ros(config, request("drone"), 3).robot_control == "external");
+  const Args args = middle(session_arguments(config, request("drone"), {7, 0, "/d", "", 3}));
+  REQUIRE(args.size() >= 2);
+  CHECK(args.at(0) == "--robot-control");
+  CHECK(args.at(1) == "external");
+  CHECK(session_ros(config, request("depot"), 3).robot_control == "builtin");
+  // The section's own default wins over the scenario's.
+  config.ros.robot_control = "builtin";
+  CHECK(session_ros(config, request("drone"), 3).robot_control == "builtin");
+}
+
 TEST_CASE("an rfb program gets the link's robot_control as {robot_control}") {
   ManagerConfig config;
   config.session_kind = SessionKind::kRfb;

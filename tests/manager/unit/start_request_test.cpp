@@ -386,6 +386,11 @@ TEST_CASE("a scenario file gives its spawn names, whether it has a robot, and it
   CHECK(bare->spawns.empty());
   CHECK_FALSE(bare->has_robot);
   CHECK_FALSE(bare->has_task);
+  CHECK(facts.robot_control == "builtin");
+  // A robot's own robot.control (issue 20): who drives it unless a link or the ros section says otherwise.
+  const auto driven = parse_scenario_facts("robot:\n  start: dock\n  control: external\n", "d", "d.yaml", error);
+  REQUIRE(driven);
+  CHECK(driven->robot_control == "external");
   const auto plain_task = parse_scenario_facts("task:\n  steps: [{type: reach}]\n", "t", "t.yaml", error);
   REQUIRE(plain_task);
   CHECK(plain_task->has_task);

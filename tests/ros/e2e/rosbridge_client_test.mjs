@@ -18,7 +18,8 @@ import path from 'node:path';
 
 import { Sim, atEnd, check, log, parseArgs, poll, readEvents, robotRows, runTest, sleep } from './ros_e2e_support.mjs';
 
-const TOKEN = 'lab-token-7f3a';
+// Long, as a JWT can be: sim_rfb must send it whole (it takes up to 4096 characters).
+const TOKEN = `lab-token-7f3a.${'x'.repeat(2000)}`;
 const NAMESPACE = '/lab1';
 const TOPICS = ['/clock', '/tf', '/odom', '/scan', '/map', '/scene_markers', '/cmd_vel', '/people', '/plan',
                 '/goal_pose', '/events'];
