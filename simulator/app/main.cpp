@@ -265,7 +265,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   if (!options.data_dir.empty()) {
     sim::SessionInfo info = prepared.info;
     if (ros_link) {
-      if (options.mcap) info.ros_bag = "session.mcap";
+      if (ros_link->writes_bag()) info.ros_bag = "session.mcap";
       info.ros_bridge = ros_link->bridge_description();
       info.ros_namespace = options.ros_namespace;
     }

@@ -177,6 +177,8 @@ std::optional<int> RosLink::server_port() const {
   return impl_->server->port();
 }
 
+bool RosLink::writes_bag() const { return impl_->bag != nullptr; }
+
 std::optional<std::string> RosLink::bag_failure() const {
   if (!impl_->bag) return std::nullopt;
   return impl_->bag->failure();

@@ -65,6 +65,8 @@ class RosLink {
 
   /// The rosbridge server's port (after binding port 0), or none without a server.
   [[nodiscard]] std::optional<int> server_port() const;
+  /// Whether it writes a bag (session.mcap).
+  [[nodiscard]] bool writes_bag() const;
   /// Why the bag stopped being written (a full disk), if it did.
   [[nodiscard]] std::optional<std::string> bag_failure() const;
   /// "server 127.0.0.1:9090" ("server [::1]:9090"), "client wss://...", "server ... + client ..." or "" (for

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -40,8 +41,26 @@ std::string read_token_file(const std::string& path) {
   return token;
 }
 
+namespace {
+
+// The bag's floor (ros::McapOptions::min_free_bytes): below it the bag would only take the space the session's
+// own files need, so none is started.
+constexpr std::uint64_t kBagMinFreeBytes = 64u << 20;
+
+// Whether the file system holding `dir` has room for a bag beside the session's own files.
+bool room_for_bag(const std::filesystem::path& dir) {
+  std::error_code ec;
+  const std::filesystem::space_info space = std::filesystem::space(dir, ec);
+  if (ec || space.available >= kBagMinFreeBytes) return true;  // unknown: the writer thread checks each chunk
+  std::fprintf(stderr, "[ros] %s has %ju KiB free, under the bag's 64 MiB floor: no session.mcap; the session's "
+                       "other files keep the space\n", dir.c_str(), static_cast<std::uintmax_t>(space.available >> 10));
+  return false;
+}
+
+}  // namespace
+
 std::unique_ptr<RosLink> open_ros_link(const SimOptions& options) {
-  const bool bag = !options.data_dir.empty() && options.mcap;
+  bool bag = !options.data_dir.empty() && options.mcap;
   if (!bag && !options.rosbridge_port && options.rosbridge_connect.empty()) return nullptr;
   RosLinkOptions ros;
   if (bag) {
@@ -50,8 +69,10 @@ std::unique_ptr<RosLink> open_ros_link(const SimOptions& options) {
       throw std::runtime_error(options.data_dir + " already holds a session (session.json); give a new folder");
     }
     std::filesystem::create_directories(options.data_dir);
-    ros.bag_file = std::filesystem::path(options.data_dir) / "session.mcap";
+    bag = room_for_bag(options.data_dir);
+    if (bag) ros.bag_file = std::filesystem::path(options.data_dir) / "session.mcap";
   }
+  if (!bag && !options.rosbridge_port && options.rosbridge_connect.empty()) return nullptr;
   ros.server_port = options.rosbridge_port;
   ros.server_bind = options.rosbridge_bind;
   ros.connect_url = options.rosbridge_connect;

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "ros/mcap/file_thread.hpp"
 
+#include <sys/statvfs.h>
+
 #include <fcntl.h>
 #include <unistd.h>
 #include <zstd.h>
@@ -149,6 +151,15 @@ void FileThread::perform(Job& job) {
 
 void FileThread::write_chunk_now(ClosedChunk& chunk) {
   if (write_failed_) return;
+  if (settings_.min_free_bytes > 0) {
+    struct statvfs disk {};
+    const std::uint64_t needed = settings_.min_free_bytes + chunk.records.size();
+    if (::fstatvfs(fd_, &disk) == 0 && static_cast<std::uint64_t>(disk.f_bavail) * disk.f_frsize < needed) {
+      fail(path_.filename().string() + ": stopped at byte " + std::to_string(offset_) + ": the disk has less than " +
+           std::to_string(settings_.min_free_bytes >> 20) + " MiB free, which the session's other files keep");
+      return;
+    }
+  }
   const std::uint32_t crc = crc32_update(0, chunk.records.data(), chunk.records.size());
 
   // Compress (or store) the records.

@@ -37,6 +37,9 @@ struct FileThreadSettings {
   int zstd_level = 3;                         ///< zstd's level (1 fast .. 19 small)
   bool sync = true;                           ///< fdatasync after each chunk
   std::size_t max_queued_bytes = 32u << 20;   ///< uncompressed chunk bytes waiting; more is a failure
+  /// Bytes the file system must keep free after a chunk; a chunk that would leave less fails the bag (0 = no
+  /// floor). The bag is the session's largest file and a copy of the others: it must not take their last space.
+  std::uint64_t min_free_bytes = 0;
 };
 
 class FileThread {

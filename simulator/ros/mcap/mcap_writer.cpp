@@ -26,7 +26,7 @@ McapWriter::McapWriter(std::filesystem::path file, McapOptions options)
   thread_ = std::make_unique<mcap::FileThread>(
       fd, path_,
       mcap::FileThreadSettings{options_.compression == McapOptions::Compression::kZstd, options_.zstd_level,
-                               options_.sync, options_.max_queued_bytes});
+                               options_.sync, options_.max_queued_bytes, options_.min_free_bytes});
   std::vector<std::uint8_t> start(mcap::kMagic.begin(), mcap::kMagic.end());
   mcap::append_header(start, "ros2", options_.library);
   thread_->write_record(mcap::Opcode::kHeader, std::move(start));

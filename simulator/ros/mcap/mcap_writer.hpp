@@ -42,6 +42,9 @@ struct McapOptions {
   bool sync = true;                                ///< fdatasync after each chunk (on the writer thread)
   std::string library = "rfbsim";                  ///< the Header's library field
   std::size_t max_queued_bytes = 32u << 20;        ///< closed chunks waiting for the disk; more fails the bag
+  /// Free bytes a chunk must leave on the file system, or the bag stops (failure()) and the rest of the session's
+  /// files keep the space: 64 MiB by default; 0 = no floor.
+  std::uint64_t min_free_bytes = 64u << 20;
 };
 
 class McapWriter {

@@ -131,3 +131,23 @@ TEST_CASE("ids that were never handed out are refused") {
   CHECK_FALSE(bag.failure());
   CHECK_THROWS_AS(bag.add_schema("a", "b", "c"), std::logic_error);
 }
+
+TEST_CASE("a bag stops at a chunk that would leave less than its free-space floor, and the file stays whole") {
+  ScratchDir dir("rfbsim_mcap");
+  McapOptions options;
+  // No disk has this much free: the first chunk is refused, as on a nearly full one with the 64 MiB default.
+  options.min_free_bytes = std::uint64_t{1} << 60;
+  McapWriter bag(dir.path() / "session.mcap", options);
+  const std::uint16_t schema = bag.add_schema("std_msgs/msg/String", "ros2msg", "string data\n");
+  const std::uint16_t channel = bag.add_channel(schema, "/t", "cdr");
+  const std::vector<std::uint8_t> message(100, 7);
+  bag.write(channel, 1, 1, message.data(), message.size());
+  bag.finish();
+  REQUIRE(bag.failure());
+  CHECK(bag.failure()->find("MiB free, which the session's other files keep") != std::string::npos);
+  // What was written before it (magic, header) is still a readable start of a file, with no chunk.
+  const Bytes bytes = read_file(dir.path() / "session.mcap");
+  bool torn = false;
+  const std::vector<Record> records = walk(bytes, 8, bytes.size(), torn);
+  for (const Record& record : records) CHECK(record.opcode != 0x06);
+}
