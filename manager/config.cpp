@@ -166,8 +166,10 @@ const std::map<std::string, Setting>& settings() {
            c.session_kind = SessionKind::kSimRfb;
          } else if (v.front() == "rfb") {
            c.session_kind = SessionKind::kRfb;
+         } else if (v.front() == "x11") {
+           c.session_kind = SessionKind::kX11;
          } else {
-           return "expected sim_rfb or rfb";
+           return "expected sim_rfb, rfb or x11";
          }
          return "";
        }}},
@@ -204,6 +206,7 @@ const std::map<std::string, Setting>& settings() {
            }
          }
          c.scenarios = v;
+         c.scenarios_set = true;
          return "";
        }}},
       {"frame_origins", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
@@ -246,6 +249,7 @@ const std::map<std::string, Setting>& settings() {
          if (!parse_integer<std::uint64_t>(v.front(), 0, 1ULL << 30, c.limits.address_space_mb)) {
            return "expected MiB, 0 = no limit";
          }
+         c.limits.address_space_set = true;
          return "";
        }}},
       {"limit_open_files", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
@@ -373,6 +377,34 @@ const std::map<std::string, Setting>& settings() {
          c.limits.cpu_slack = std::chrono::seconds(value);
          return "";
        }}},
+      // The x11 section (x11: {geometry, depth, xvnc}): the display each x11 session's program runs on.
+      {"x11_geometry", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         const std::string& text = v.front();
+         const std::size_t x = text.find('x');
+         int width = 0;
+         int height = 0;
+         // Xvnc needs whole pixels; a screen past 8192 would cost a participant's link more than any program.
+         if (x == std::string::npos || !parse_integer(text.substr(0, x), 64, 8192, width) ||
+             !parse_integer(text.substr(x + 1), 64, 8192, height)) {
+           return "expected WIDTHxHEIGHT, each 64..8192 (e.g. 1280x720)";
+         }
+         c.x11.width = width;
+         c.x11.height = height;
+         return "";
+       }}},
+      {"x11_depth", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         int depth = 0;
+         if (!parse_integer(v.front(), 16, 32, depth) || (depth != 16 && depth != 24 && depth != 32)) {
+           return "expected 16, 24 or 32";
+         }
+         c.x11.depth = depth;
+         return "";
+       }}},
+      {"x11_xvnc", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         if (v.front().empty() || v.front().front() != '/') return "expected the absolute path of TigerVNC's Xvnc";
+         c.x11.xvnc = v.front();
+         return "";
+       }}},
   };
   return table;
 }
@@ -400,11 +432,35 @@ std::vector<std::string> split_commas(const std::string& text) {
 
 }  // namespace
 
-const char* session_kind_name(SessionKind kind) { return kind == SessionKind::kSimRfb ? "sim_rfb" : "rfb"; }
+const char* session_kind_name(SessionKind kind) {
+  switch (kind) {
+    case SessionKind::kSimRfb:
+      return "sim_rfb";
+    case SessionKind::kRfb:
+      return "rfb";
+    case SessionKind::kX11:
+      return "x11";
+  }
+  return "sim_rfb";
+}
+
+void finish_config(ManagerConfig& config) {
+  // A program's scenarios are its own: unless the config names some for its {scenario}, it has none, and its
+  // links need only uid.
+  if (config.session_kind != SessionKind::kSimRfb && !config.scenarios_set) config.scenarios.clear();
+}
+
+ProcessLimits session_limits(const ManagerConfig& config) {
+  ProcessLimits limits = config.limits;
+  if (!limits.address_space_set && config.session_kind == SessionKind::kX11) {
+    limits.address_space_mb = kDefaultX11AddressSpaceMb;
+  }
+  return limits;
+}
 
 std::string manager_usage() {
   return "usage: sim_manager [--config FILE] [--listen-address ADDR] [--port N] [--tls-certificate PEM]\n"
-         "                   [--tls-private-key PEM] [--session-command PROGRAM] [--session-kind sim_rfb|rfb]\n"
+         "                   [--tls-private-key PEM] [--session-command PROGRAM] [--session-kind sim_rfb|rfb|x11]\n"
          "                   [--session-arg ARG]... [--codec auto|jpeg|h264] [--max-sessions N]\n"
          "                   [--max-duration-s S] [--idle-timeout-s S]\n"
          "                   [--data-dir DIR] [--scenarios A,B] [--frame-origins O1,O2] [--admin-token T]\n"
@@ -416,8 +472,9 @@ std::string manager_usage() {
          "  --port N                the one public port (default 8080; 0 = any free port)\n"
          "  --tls-certificate F, --tls-private-key F   serve HTTPS and WSS (OpenSSL)\n"
          "  --session-command P     program started per session (default: sim_rfb)\n"
-         "  --session-kind K        sim_rfb (default), or rfb: any program that serves raw RFB on the port\n"
-         "                          given as {port} in its --session-arg list\n"
+         "  --session-kind K        sim_rfb (default); rfb: any program that serves raw RFB on the port\n"
+         "                          given as {port} in its --session-arg list (one linking librfbsim); or x11:\n"
+         "                          any X11 program, each session on its own Xvnc display (the x11: section)\n"
          "  --session-arg A         one more argument for the session program (repeat as needed)\n"
          "  --codec C               sim_rfb's picture encoding: auto (default: Tight JPEG, H.264 for a browser\n"
          "                          that offers it once its link needs it), jpeg, or h264 (H.264 for every\n"
@@ -473,6 +530,9 @@ std::string manager_usage() {
          "  --ros-namespace NS      each session's topics under NS/s_<id> (default /rfbsim)\n"
          "  --ros-robot-control builtin|external  who drives the robot where a link does not say (default builtin)\n"
          "  --ros-cmd-vel-type twist|twist_stamped  the type of the lab's /cmd_vel (default twist)\n"
+         "  --x11-geometry WxH      session_kind x11: the display's size (default 1280x720; the x11: section)\n"
+         "  --x11-depth D           its bits per pixel: 16, 24 (default) or 32\n"
+         "  --x11-xvnc PATH         TigerVNC's Xvnc (default /usr/bin/Xvnc)\n"
          "  --sign QUERY            print QUERY with its link signature (needs a link secret) and exit\n";
 }
 
@@ -534,35 +594,41 @@ ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
     }
     const std::string key = item.first.Scalar();
     const std::string line = path + ":" + std::to_string(item.first.Mark().line + 1) + ": ";
-    // The ros section is a mapping of its own (ros: {connect: ...}); its keys are the table's ros_<key>, which
-    // the file names only that way, so that one setting has one spelling there.
-    if (key.rfind("ros_", 0) == 0) {
-      outcome.error = line + key + ": unknown setting (write it as " + key.substr(4) + ": under ros:)";
-      return outcome;
+    // The ros and x11 sections are mappings of their own (ros: {connect: ...}); their keys are the table's
+    // <section>_<key>, which the file names only that way, so that one setting has one spelling there.
+    static const std::map<std::string, std::vector<std::string>> kSections = {
+        {"ros", {"connect", "token_file", "ca_file", "namespace", "robot_control", "cmd_vel_type"}},
+        {"x11", {"geometry", "depth", "xvnc"}}};
+    for (const auto& [section, keys] : kSections) {
+      if (key.rfind(section + "_", 0) == 0) {
+        outcome.error = line + key + ": unknown setting (write it as " + key.substr(section.size() + 1) + ": under " +
+                        section + ":)";
+        return outcome;
+      }
     }
-    if (key != "ros") {
+    const auto section = kSections.find(key);
+    if (section == kSections.end()) {
       if (!apply(key, key, item.first, item.second)) return outcome;
       continue;
     }
+    std::string known;
+    for (const std::string& name : section->second) known += (known.empty() ? "" : ", ") + name;
     if (!item.second.IsMap()) {
-      outcome.error = line + "ros: expected a mapping (connect, token_file, ca_file, namespace, robot_control, cmd_vel_type)";
+      outcome.error = line + key + ": expected a mapping (" + known + ")";
       return outcome;
     }
     for (const auto& sub : item.second) {
+      const std::string at = path + ":" + std::to_string(sub.first.Mark().line + 1) + ": ";
       if (!sub.first.IsScalar()) {
-        outcome.error = path + ":" + std::to_string(sub.first.Mark().line + 1) + ": ros: expected a setting name as key";
+        outcome.error = at + key + ": expected a setting name as key";
         return outcome;
       }
       const std::string name = sub.first.Scalar();
-      static const char* const kRosKeys[] = {"connect", "token_file", "ca_file", "namespace", "robot_control",
-                                             "cmd_vel_type"};
-      const bool known = std::find(std::begin(kRosKeys), std::end(kRosKeys), name) != std::end(kRosKeys);
-      if (!known) {
-        outcome.error = path + ":" + std::to_string(sub.first.Mark().line + 1) + ": ros." + name +
-                        ": unknown setting (known: connect, token_file, ca_file, namespace, robot_control, cmd_vel_type)";
+      if (std::find(section->second.begin(), section->second.end(), name) == section->second.end()) {
+        outcome.error = at + key + "." + name + ": unknown setting (known: " + known + ")";
         return outcome;
       }
-      if (!apply("ros_" + name, "ros." + name, sub.first, sub.second)) return outcome;
+      if (!apply(key + "_" + name, key + "." + name, sub.first, sub.second)) return outcome;
     }
   }
   return outcome;
@@ -651,6 +717,7 @@ ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
   if (config.path_prefix.empty() && !config.cluster_peers.empty() && is_path_prefix("/" + config.host_id)) {
     config.path_prefix = "/" + config.host_id;
   }
+  finish_config(config);
   if (outcome.error.empty()) outcome.error = validate_config(outcome.config);
   return outcome;
 }
@@ -716,6 +783,16 @@ std::string ros_problem(const ManagerConfig& config) {
 std::string validate_config(const ManagerConfig& config) {
   if (config.tls_certificate.empty() != config.tls_private_key.empty()) {
     return "TLS needs both tls_certificate and tls_private_key";
+  }
+  if (config.session_kind == SessionKind::kX11) {
+    if (config.session_command == "sim_rfb") {
+      return "session_kind x11 needs session_command: the X11 program each session runs (e.g. /usr/bin/glxgears)";
+    }
+    for (const std::string& arg : config.session_args) {
+      if (arg.find("{port}") != std::string::npos) {
+        return "session_kind x11 has no {port}: the program draws on its own display, which the manager serves";
+      }
+    }
   }
   if (config.session_kind == SessionKind::kRfb) {
     bool has_port = false;

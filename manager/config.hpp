@@ -13,12 +13,24 @@
 
 namespace rfbsim::manager {
 
+/// session_kind x11: the private display each session's program runs on (the `x11:` section).
+struct X11Settings {
+  int width = 1280;                    ///< the display's and so the picture's size (geometry: WxH)
+  int height = 720;
+  int depth = 24;                      ///< 16, 24 or 32 bits per pixel
+  std::string xvnc = "/usr/bin/Xvnc";  ///< TigerVNC's X server (Debian: tigervnc-standalone-server)
+};
+
 /// How the manager talks to the program it starts for each session.
 enum class SessionKind {
   kSimRfb,  ///< sim_rfb: the manager adds --port 0 --rfb-only --ready-fd 3, --codec and the link's parameters
   kRfb,     ///< any program serving raw RFB on a loopback port: args may use {port} {scenario} {seed} {uid}
             ///< {data_dir} {t1} {t2} and the overrides' {avatar_start} {avatar_goal} {robot_start}
-            ///< {robot_goal} {crowd} {robot_control} (session_arguments); ready once the port accepts a connection
+            ///< {robot_goal} {crowd} {robot_control} (session_arguments); ready once the port accepts a connection.
+            ///< A program linking librfbsim (examples/mujoco_rfb) is served this way.
+  kX11,     ///< any unmodified X11 program (session_command), per session on its own TigerVNC Xvnc display that
+            ///< only the manager reaches (rfbsim_x11_session: an RFB unix socket of mode 0600 and a fresh
+            ///< Xauthority); args may use the kRfb placeholders but {port}
 };
 
 /// The default RLIMIT_AS of sessions, MiB. AddressSanitizer builds (scripts/test.sh --sanitize) reserve
@@ -29,9 +41,19 @@ inline constexpr std::uint64_t kDefaultAddressSpaceMb = 0;
 inline constexpr std::uint64_t kDefaultAddressSpaceMb = 8192;
 #endif
 
-/// Resource limits applied to every session process (0 = no limit).
+/// The default RLIMIT_AS of x11 sessions, MiB: a Unity or Gazebo client reserves far more address space than it
+/// uses (Unity's Mono heap and Mesa's llvmpipe each map GiBs up front), so sim_rfb's default would refuse them.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr std::uint64_t kDefaultX11AddressSpaceMb = 0;
+#else
+inline constexpr std::uint64_t kDefaultX11AddressSpaceMb = 65536;
+#endif
+
+/// Resource limits applied to every session process (0 = no limit). The defaults depend on the session kind
+/// (session_limits) where the config does not set them.
 struct ProcessLimits {
   std::uint64_t address_space_mb = kDefaultAddressSpaceMb;  ///< RLIMIT_AS, MiB (llvmpipe reserves a lot)
+  bool address_space_set = false;         ///< limit_address_space_mb was given: kept for every kind
   std::uint64_t open_files = 1024;        ///< RLIMIT_NOFILE
   /// RLIMIT_CPU = max_duration x cpu_time_factor + cpu_slack: a session may use about this many cores on
   /// average (renderer threads) and the slack covers start-up and the stop grace period.
@@ -97,6 +119,9 @@ struct ManagerConfig {
   std::chrono::seconds stop_grace{5};        ///< SIGTERM, then SIGKILL after this long
   std::string data_dir = "rfbsim-data";      ///< session index (sessions.db) and one folder per session
   std::vector<std::string> scenarios = {"warehouse", "lab"};  ///< allowed; the first is the default
+  /// scenarios was given (file or flag). Unset, kRfb and kX11 sessions have none (finish_config): their links
+  /// need only uid, and a program has no scenario unless the config names some for its {scenario}.
+  bool scenarios_set = false;
   std::vector<std::string> frame_origins;    ///< origins allowed to frame the page and open its WebSocket
   std::string admin_token;                   ///< empty = /admin and /api are off
   std::string link_secret;                   ///< non-empty = /start links must carry a valid sig
@@ -136,6 +161,7 @@ struct ManagerConfig {
   std::string registry_bind;        ///< the registry's numeric IPv4 address; empty = listen_address
   /// The `ros:` section: sessions of scenarios with a robot dial out to a lab's rosbridge_server (kSimRfb only).
   RosSettings ros;
+  X11Settings x11;  ///< the `x11:` section (kX11 only)
 };
 
 /// The outcome of reading settings: a config, or a message naming the file, line or flag at fault.
@@ -153,6 +179,14 @@ ConfigOutcome load_config_file(const std::string& path, ManagerConfig base);
 /// RFBSIM_ADMIN_TOKEN and RFBSIM_LINK_SECRET from `environment` where the flags left them empty.
 ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
                                  const std::vector<std::pair<std::string, std::string>>& environment = {});
+
+/// Settles what depends on the session kind once every source is read: kRfb and kX11 without scenarios_set
+/// offer none (links need only uid). parse_manager_args calls it last.
+void finish_config(ManagerConfig& config);
+
+/// The resource limits of `config`'s sessions: config.limits, with the address space of its kind's default
+/// (kDefaultX11AddressSpaceMb for kX11) unless limit_address_space_mb was set.
+ProcessLimits session_limits(const ManagerConfig& config);
 
 /// Checks a finished config for settings that cannot work together; "" when it is fine.
 std::string validate_config(const ManagerConfig& config);
@@ -175,7 +209,7 @@ std::string fit_max_duration(ManagerConfig& config);
 /// The --help text.
 std::string manager_usage();
 
-/// "sim_rfb" or "rfb".
+/// "sim_rfb", "rfb" or "x11".
 const char* session_kind_name(SessionKind kind);
 
 }  // namespace rfbsim::manager

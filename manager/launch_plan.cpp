@@ -28,6 +28,30 @@ std::string expand(const std::string& text, const std::vector<std::pair<std::str
   return out;
 }
 
+// config.session_args with the link's and the session's values put in (session_arguments, kRfb and kX11).
+std::vector<std::string> expand_template(const ManagerConfig& config, const StartRequest& request,
+                                         const LaunchContext& context, const std::string& scenario) {
+  std::vector<std::pair<std::string, std::string>> values = {{"{scenario}", scenario},
+                                                              {"{seed}", std::to_string(context.seed)},
+                                                              {"{uid}", request.uid},
+                                                              {"{t1}", request.code_success},
+                                                              {"{t2}", request.code_timeout},
+                                                              {"{data_dir}", context.data_dir}};
+  // An x11 program draws on its display: it has no port (validate_config refuses {port} there).
+  if (config.session_kind == SessionKind::kRfb) values.emplace_back("{port}", std::to_string(context.port));
+  // The link's overrides too, each as {name} (empty when the link has none): validated like sim_rfb's,
+  // they are the study's conditions, and a program whose template leaves them out never sees them.
+  for (const OverrideParam& param : kOverrideParams) {
+    const auto given = std::find_if(request.overrides.begin(), request.overrides.end(),
+                                    [&param](const auto& override_) { return override_.first == param.name; });
+    values.emplace_back("{" + std::string(param.name) + "}",
+                        given == request.overrides.end() ? std::string() : given->second);
+  }
+  std::vector<std::string> args;
+  for (const std::string& arg : config.session_args) args.push_back(expand(arg, values));
+  return args;
+}
+
 }  // namespace
 
 // Where sim_rfb listens and how it reports (--bind, --port, --unix-socket, --ready-fd, --rfb-only,
@@ -124,24 +148,14 @@ std::string ros_request_problem(const ManagerConfig& config, const StartRequest&
 std::vector<std::string> session_arguments(const ManagerConfig& config, const StartRequest& request,
                                            const LaunchContext& context) {
   const std::string scenario = scenario_argument(config.scenarios, request.scenario);
-  if (config.session_kind == SessionKind::kRfb) {
-    std::vector<std::pair<std::string, std::string>> values = {{"{port}", std::to_string(context.port)},
-                                                                {"{scenario}", scenario},
-                                                                {"{seed}", std::to_string(context.seed)},
-                                                                {"{uid}", request.uid},
-                                                                {"{t1}", request.code_success},
-                                                                {"{t2}", request.code_timeout},
-                                                                {"{data_dir}", context.data_dir}};
-    // The link's overrides too, each as {name} (empty when the link has none): validated like sim_rfb's,
-    // they are the study's conditions, and a program whose template leaves them out never sees them.
-    for (const OverrideParam& param : kOverrideParams) {
-      const auto given = std::find_if(request.overrides.begin(), request.overrides.end(),
-                                      [&param](const auto& override_) { return override_.first == param.name; });
-      values.emplace_back("{" + std::string(param.name) + "}",
-                          given == request.overrides.end() ? std::string() : given->second);
-    }
-    std::vector<std::string> args;
-    for (const std::string& arg : config.session_args) args.push_back(expand(arg, values));
+  if (config.session_kind == SessionKind::kRfb) return expand_template(config, request, context, scenario);
+  if (config.session_kind == SessionKind::kX11) {
+    std::vector<std::string> args = {"--rfb-socket", context.unix_socket, "--xauthority", context.xauthority,
+                                     "--geometry", std::to_string(config.x11.width) + "x" + std::to_string(config.x11.height),
+                                     "--depth", std::to_string(config.x11.depth), "--xvnc", config.x11.xvnc,
+                                     "--ready-fd", std::to_string(kReadyFd), "--", config.session_command};
+    const std::vector<std::string> program_args = expand_template(config, request, context, scenario);
+    args.insert(args.end(), program_args.begin(), program_args.end());
     return args;
   }
   // The config's extra arguments first: sim_rfb takes the last of a repeated flag, so everything the

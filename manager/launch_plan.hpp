@@ -22,6 +22,9 @@ struct LaunchContext {
   /// TCP port it picks and reports.
   std::string unix_socket;
   std::int64_t session_id = 0;  ///< the session's index id, which names it under the ROS namespace
+  /// kX11: the session's Xauthority file, written fresh by rfbsim_x11_session (beside unix_socket, where only
+  /// the manager's user can read it).
+  std::string xauthority{};
 };
 
 /// What a session is told of ROS (the config's `ros:` section and the link's robot_control).
@@ -55,6 +58,9 @@ std::string ros_request_problem(const ManagerConfig& config, const StartRequest&
 ///    placeholder per override, {avatar_start} {avatar_goal} {robot_start} {robot_goal} {crowd} {robot_control},
 ///    replaced;
 ///    a code or override the link does not have becomes "".
+///  - kX11: rfbsim_x11_session's --rfb-socket S (context.unix_socket) --xauthority F --geometry WxH --depth D
+///    --xvnc PATH --ready-fd 3, then `--` and config.session_command with config.session_args expanded as for
+///    kRfb (there is no {port}).
 std::vector<std::string> session_arguments(const ManagerConfig& config, const StartRequest& request,
                                            const LaunchContext& context);
 

@@ -79,6 +79,21 @@ std::string resolve_program(const std::string& command) {
   return std::filesystem::absolute(command).string();
 }
 
+// session_kind x11: the process started per session is rfbsim_x11_session (the one built beside this binary, else
+// the installed one), which starts Xvnc and the configured program; both must be there before any link is served.
+std::string resolve_x11_session(ManagerConfig& config) {
+  config.session_command = resolve_program(config.session_command);
+  if (!is_executable(config.x11.xvnc)) {
+    throw std::runtime_error("session_kind x11 needs TigerVNC's Xvnc, not found at " + config.x11.xvnc +
+                             " (Debian: apt install tigervnc-standalone-server; or set x11.xvnc)");
+  }
+  for (const char* candidate : {RFBSIM_BUILD_X11_SESSION, RFBSIM_INSTALLED_X11_SESSION}) {
+    if (is_executable(candidate)) return candidate;
+  }
+  throw std::runtime_error(std::string("rfbsim_x11_session not found (looked for ") + RFBSIM_BUILD_X11_SESSION +
+                           " and " + RFBSIM_INSTALLED_X11_SESSION + "); build or install rfbsim");
+}
+
 std::string resolve_web_root(const std::string& requested) {
   std::vector<std::string> candidates;
   if (!requested.empty()) {
@@ -136,7 +151,9 @@ constexpr int kReaderBusyTimeoutMs = 100;
 
 int run(ManagerConfig config) {
   namespace manager = rfbsim::manager;
-  const std::string program = resolve_program(config.session_command);
+  const std::string program = config.session_kind == rfbsim::manager::SessionKind::kX11
+                                  ? resolve_x11_session(config)
+                                  : resolve_program(config.session_command);
   const std::string web_root = resolve_web_root(config.web_root);
   learn_scenarios(config);
   if (config.host_id.empty()) config.host_id = default_host_id();
@@ -235,10 +252,13 @@ int run(ManagerConfig config) {
 
   const std::string host = config.listen_address == "0.0.0.0" ? "127.0.0.1" : config.listen_address;
   const std::string base = std::string(frontend->scheme()) + "://" + host + ":" + std::to_string(frontend->port());
-  std::string example = "uid=demo&scenario=" + manager::scenario_names(config.scenarios).front();
+  // A program without scenarios (session kinds rfb and x11 by default) takes links with only a uid.
+  std::string example = "uid=demo";
+  if (!config.scenarios.empty()) example += "&scenario=" + manager::scenario_names(config.scenarios).front();
   if (!config.link_secret.empty()) example = manager::sign_query(example, config.link_secret);
   std::fprintf(stderr, "[manager] sessions: %s (%s), at most %d, %lld s each, idle timeout %lld s; data in %s\n",
-               program.c_str(), manager::session_kind_name(config.session_kind), config.max_sessions,
+               (config.session_kind == manager::SessionKind::kX11 ? config.session_command : program).c_str(),
+               manager::session_kind_name(config.session_kind), config.max_sessions,
                static_cast<long long>(config.max_duration.count()),
                static_cast<long long>(config.idle_timeout.count()), config.data_dir.c_str());
   std::printf("sim_manager ready: %s/\nparticipant link: %s/start?%s\n", base.c_str(), base.c_str(), example.c_str());

@@ -120,6 +120,11 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
       request.uid = value;
       have_uid = true;
     } else if (name == "scenario") {
+      if (scenarios.empty()) {
+        out.error = "scenario '" + shown(value) + "' is not offered here: this server's program has no scenarios, and "
+                    "its links need only uid";
+        return out;
+      }
       if (std::find(scenarios.begin(), scenarios.end(), value) == scenarios.end() || !is_identifier(value)) {
         std::string allowed;
         for (const std::string& s : scenarios) allowed += (allowed.empty() ? "" : ", ") + s;
@@ -174,13 +179,8 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
     out.error = "the link has no uid (participant id)";
     return out;
   }
-  if (!have_scenario) {
-    if (scenarios.empty()) {
-      out.error = "no scenario is offered here";
-      return out;
-    }
-    request.scenario = scenarios.front();
-  }
+  // Without a list (a program's session kind that names none) a session has no scenario.
+  if (!have_scenario && !scenarios.empty()) request.scenario = scenarios.front();
   // Overrides in a fixed order, so that equal links give equal command lines and index rows.
   for (const OverrideParam& param : kOverrideParams) {
     for (const auto& [name, value] : params) {

@@ -20,7 +20,7 @@ namespace rfbsim::manager {
 /// What a participant's link asks for, all of it valid.
 struct StartRequest {
   std::string uid;                    ///< participant id: letters, digits, - and _, 1..64
-  std::string scenario;               ///< a name from the allowed list
+  std::string scenario;               ///< a name from the allowed list; "" where the list is empty
   std::optional<std::uint64_t> seed;  ///< unset = the manager draws one (and records it)
   /// Scenario overrides as (link parameter, value), in the order of kOverrideParams; e.g.
   /// ("avatar_start", "1.5,-2,0.25"), ("crowd", "10") or ("robot_control", "external").
@@ -55,7 +55,8 @@ bool is_identifier(std::string_view text);
 bool is_pose(std::string_view text);
 
 /// Validates the parameters of /start (`sig` is checked elsewhere and ignored here). `scenarios` are the
-/// allowed names; an absent scenario means the first. Unknown parameters are refused.
+/// allowed names; an absent scenario means the first. An empty list offers none (session kinds rfb and x11 without
+/// scenarios): the scenario is "" and a link that names one is refused. Unknown parameters are refused.
 StartParse parse_start_request(const QueryParams& params, const std::vector<std::string>& scenarios);
 
 /// As above, then each pose override that names a spawn point must be one of the scenario's (`facts`, found by

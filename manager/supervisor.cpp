@@ -28,6 +28,7 @@
 #include "session_process.hpp"
 #include "session_views.hpp"
 #include "tokens.hpp"
+#include "x11_display.hpp"
 
 namespace rfbsim::manager {
 
@@ -110,6 +111,7 @@ struct Supervisor::Runtime {
   bool bad_stream_logged = false;  // a bad stream line is logged once per session, not every second
   int clients = 0;
   bool ever_connected = false;  // a participant's browser connected at least once
+  int x11_display = -1;         // kX11: the display rfbsim_x11_session reported, cleaned after a SIGKILL
   SteadyClock::time_point started;
 };
 
@@ -129,7 +131,11 @@ Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::s
       child_watch_(std::make_unique<ChildWatch>(io)),
       writer_(std::make_unique<IndexWriter>(index.path())),
       launcher_(std::make_unique<ProcessLauncher>()) {
-  if (config_.session_kind == SessionKind::kSimRfb && config_.session_socket == "unix") socket_dir_ = make_socket_dir();
+  // x11 sessions always use it: their RFB socket and Xauthority must be the manager's user's alone.
+  if ((config_.session_kind == SessionKind::kSimRfb && config_.session_socket == "unix") ||
+      config_.session_kind == SessionKind::kX11) {
+    socket_dir_ = make_socket_dir();
+  }
   next_id_ = index_.max_id() + 1;
   for (const auto& [state, count] : index_.count_by_state()) {
     if (!is_live(state)) ended_counts_[state] = count;
@@ -321,6 +327,7 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
     } else if (!socket_dir_.empty()) {
       context.unix_socket = socket_dir_ + "/" + std::to_string(session.id) + ".sock";
       session.unix_socket = context.unix_socket;
+      if (config_.session_kind == SessionKind::kX11) context.xauthority = x11_xauthority_path(session.id);
     }
     job.folder = context.data_dir;
     SpawnSpec& spec = job.spec;
@@ -328,9 +335,10 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
     spec.args = session_arguments(config_, request, context);
     spec.working_dir = context.data_dir;
     spec.log_file = context.data_dir + "/session.log";
-    spec.ready_pipe = config_.session_kind == SessionKind::kSimRfb;
-    spec.limits.address_space_bytes = config_.limits.address_space_mb * 1024 * 1024;
-    spec.limits.open_files = config_.limits.open_files;
+    spec.ready_pipe = config_.session_kind != SessionKind::kRfb;
+    const ProcessLimits limits = session_limits(config_);
+    spec.limits.address_space_bytes = limits.address_space_mb * 1024 * 1024;
+    spec.limits.open_files = limits.open_files;
     spec.limits.cpu_seconds = cpu_limit_seconds(config_);
   } catch (const std::exception& error) {
     fail_start(std::move(session), error.what(), reply);
@@ -417,9 +425,10 @@ void Supervisor::launched(std::int64_t id, LaunchResult result, StartReply reply
   session->pid = result.process.pid;
   session->process_start = result.process.start_ticks;
   metrics_.count_start();
-  log_session(*session, "started " +
-                            std::string(config_.session_kind == SessionKind::kSimRfb ? "sim_rfb" : "program") +
-                            " as pid " + std::to_string(session->pid) + " in " + session->data_path);
+  const char* what = config_.session_kind == SessionKind::kSimRfb ? "sim_rfb"
+                     : config_.session_kind == SessionKind::kX11  ? "rfbsim_x11_session"
+                                                                  : "program";
+  log_session(*session, std::string("started ") + what + " as pid " + std::to_string(session->pid) + " in " + session->data_path);
   Runtime& rt = runtime(id);
   if (result.process.ready_fd >= 0) rt.ready_pipe.assign(result.process.ready_fd);
   if (session->state == SessionState::kEnding) {
@@ -515,6 +524,17 @@ bool Supervisor::take_pipe_line(Session& session, const std::string& line) {
                                line.substr(0, 96) + "'");
     }
     return true;
+  }
+  // rfbsim_x11_session names the display it got, so that one whose X server was SIGKILLed is cleaned after it.
+  if (config_.session_kind == SessionKind::kX11 && line.rfind("x11 display ", 0) == 0 &&
+      runtime(session.id).x11_display < 0) {
+    int display = -1;
+    char rest = 0;
+    if (std::sscanf(line.c_str() + 12, "%d%c", &display, &rest) == 1 && display >= 0 && display < 65536) {
+      runtime(session.id).x11_display = display;
+      log_session(session, "its program runs on display :" + std::to_string(display));
+      return true;
+    }
   }
   if ((line == "outcome completed" || line == "outcome timeout") && session.outcome.empty()) {
     session.outcome = line.substr(8);
@@ -671,10 +691,16 @@ void Supervisor::process_gone(Session& session, int wait_status) {
   session.state = final_state;
   session.ended_at = std::chrono::system_clock::now();
   ++ended_counts_[final_state];
-  // A killed sim_rfb leaves its socket file behind.
+  // A killed sim_rfb leaves its socket file behind; a killed rfbsim_x11_session its Xauthority, and its Xvnc
+  // (killed with the group) the display's lock file and X socket.
   if (!session.unix_socket.empty()) {
     std::error_code ignored;
     std::filesystem::remove(session.unix_socket, ignored);
+  }
+  if (config_.session_kind == SessionKind::kX11) {
+    std::error_code ignored;
+    std::filesystem::remove(x11_xauthority_path(session.id), ignored);
+    clean_x11_display(runtime(session.id).x11_display, 0);
   }
   save(session, copy_after_commit(session));
   log_session(session, std::string(state_name(final_state)) + " (" + session.exit_status + ")");
@@ -683,6 +709,23 @@ void Supervisor::process_gone(Session& session, int wait_status) {
   runtimes_.erase(id);
   table_.remove(id);  // the slot is free from here on
   notify_if_all_gone();
+}
+
+std::string Supervisor::x11_xauthority_path(std::int64_t id) const {
+  return socket_dir_ + "/" + std::to_string(id) + ".xauth";
+}
+
+void Supervisor::clean_x11_display(int display, int attempt) {
+  if (display < 0 || x11::remove_stale_display(display)) return;
+  // Its Xvnc was killed with the group a moment ago and may not be gone yet: look again, for a few seconds.
+  if (attempt >= 20) {
+    std::fprintf(stderr, "[manager] display :%d: its X server is still running; its lock file is left\n", display);
+    return;
+  }
+  auto timer = std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(250));
+  timer->async_wait([this, timer, display, attempt](const boost::system::error_code& ec) {
+    if (!ec) clean_x11_display(display, attempt + 1);
+  });
 }
 
 void Supervisor::arm_idle_timer(Session& session) {

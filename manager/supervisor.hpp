@@ -148,6 +148,11 @@ class Supervisor {
   // and returns what queues the copy once the row and manager.json are written; nullptr without a copier or folder.
   std::function<void(const std::string&)> copy_after_commit(Session& session);
   Runtime& runtime(std::int64_t id);
+  /// kX11: where session `id`'s Xauthority is written (beside its RFB socket, in the private socket folder).
+  std::string x11_xauthority_path(std::int64_t id) const;
+  /// Removes the lock file and X socket of `display` (-1: none known) once its X server is gone; looks again
+  /// every 250 ms for 5 s while it still runs (killed with the session's group, it may not have exited yet).
+  void clean_x11_display(int display, int attempt);
 
   boost::asio::io_context& io_;
   const ManagerConfig& config_;

@@ -28,8 +28,11 @@ packages=(build-essential cmake ninja-build pkg-config git
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)
 # Test-only: Chromium for the browser tests, clang and its runtimes (libFuzzer, sanitizers) for scripts/fuzz.sh,
-# HAProxy for the cluster tests (scripts/run-cluster-demo.sh; a study installs it on its balancer host).
-[ "$with_browser" = 1 ] && packages+=(chromium clang libclang-rt-14-dev haproxy)
+# HAProxy for the cluster tests (scripts/run-cluster-demo.sh; a study installs it on its balancer host),
+# MuJoCo for examples/mujoco_rfb, and TigerVNC's Xvnc with a few X11 programs (glxgears, xeyes, Xlib for our
+# key-echo program) for session_kind x11 (docs/other-simulators.md; a study installs what its own kind needs).
+[ "$with_browser" = 1 ] && packages+=(chromium clang libclang-rt-14-dev haproxy
+  libmujoco-dev tigervnc-standalone-server mesa-utils x11-apps x11-utils libx11-dev)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// rfbsim::OffscreenGL: EGL without a window system, an OpenGL 3.3 core context and an FBO.
+// rfbsim::OffscreenGL: EGL without a window system, an OpenGL context (3.3 core or compatibility) and an FBO.
 #include "rfbsim/offscreen_gl.hpp"
 
 #define GL_GLEXT_PROTOTYPES 1
@@ -13,6 +13,7 @@
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace rfbsim {
@@ -102,6 +103,54 @@ int chosen_samples(int requested, const char* gl_renderer, int most) {
   return samples > 1 ? samples : 0;
 }
 
+// The EGL attributes of a context of `profile`. Compatibility names no version: EGL then gives the newest
+// compatibility context the driver has (Mesa llvmpipe: 4.5), which fixed-function renderers such as MuJoCo
+// 2.x's need; asking for 3.3 compatibility would fail on drivers that stop compatibility at 3.0.
+std::vector<EGLint> context_attributes(GLProfile profile) {
+  if (profile == GLProfile::kCompatibility) {
+    return {EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT, EGL_NONE};
+  }
+  return {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+          EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+}
+
+const char* profile_name(GLProfile profile) {
+  return profile == GLProfile::kCompatibility ? "compatibility" : "3.3 core";
+}
+
+// Width and height of colour attachment 0 of the framebuffer bound for reading, or {0, 0} when it has none.
+// Restores the renderbuffer and texture bindings it touches.
+std::pair<GLint, GLint> read_attachment_size() {
+  GLint type = GL_NONE;
+  GLint name = 0;
+  glGetFramebufferAttachmentParameteriv(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
+                                        GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+  if (type == GL_NONE) return {0, 0};
+  glGetFramebufferAttachmentParameteriv(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
+                                        GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
+  GLint width = 0;
+  GLint height = 0;
+  if (type == GL_RENDERBUFFER) {
+    GLint previous = 0;
+    glGetIntegerv(GL_RENDERBUFFER_BINDING, &previous);
+    glBindRenderbuffer(GL_RENDERBUFFER, static_cast<GLuint>(name));
+    glGetRenderbufferParameteriv(GL_RENDERBUFFER, GL_RENDERBUFFER_WIDTH, &width);
+    glGetRenderbufferParameteriv(GL_RENDERBUFFER, GL_RENDERBUFFER_HEIGHT, &height);
+    glBindRenderbuffer(GL_RENDERBUFFER, static_cast<GLuint>(previous));
+  } else if (type == GL_TEXTURE) {
+    GLint level = 0;
+    GLint previous = 0;
+    glGetFramebufferAttachmentParameteriv(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
+                                          GL_FRAMEBUFFER_ATTACHMENT_TEXTURE_LEVEL, &level);
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &previous);
+    glBindTexture(GL_TEXTURE_2D, static_cast<GLuint>(name));
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, level, GL_TEXTURE_WIDTH, &width);
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, level, GL_TEXTURE_HEIGHT, &height);
+    glBindTexture(GL_TEXTURE_2D, static_cast<GLuint>(previous));
+  }
+  return {width, height};
+}
+
 }  // namespace
 
 struct OffscreenGL::Impl {
@@ -124,6 +173,7 @@ struct OffscreenGL::Impl {
   }
   void create_context();
   void create_framebuffers();
+  FrameView read_bound_framebuffer();
 };
 
 void OffscreenGL::Impl::create_context() {
@@ -140,11 +190,12 @@ void OffscreenGL::Impl::create_context() {
   if (eglChooseConfig(display, config_attributes, &config, 1, &found) != EGL_TRUE || found < 1) {
     throw std::runtime_error("no EGL config with RGBA8, depth 24 and desktop OpenGL: " + egl_error_text());
   }
-  const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
-                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                       EGL_NONE};
-  context = eglCreateContext(display, config, EGL_NO_CONTEXT, context_attributes);
-  if (context == EGL_NO_CONTEXT) throw std::runtime_error("cannot create an OpenGL 3.3 core context: " + egl_error_text());
+  const std::vector<EGLint> attributes = context_attributes(options.profile);
+  context = eglCreateContext(display, config, EGL_NO_CONTEXT, attributes.data());
+  if (context == EGL_NO_CONTEXT) {
+    throw std::runtime_error(std::string("cannot create an OpenGL ") + profile_name(options.profile) +
+                             " context: " + egl_error_text());
+  }
 
   const char* extensions = eglQueryString(display, EGL_EXTENSIONS);
   const bool surfaceless = extensions != nullptr && std::strstr(extensions, "EGL_KHR_surfaceless_context") != nullptr;
@@ -239,21 +290,72 @@ FrameView OffscreenGL::read_frame() {
     glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->resolve_fbo);
   }
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, impl_->bottom_up.data());
+  const FrameView frame = impl_->read_bound_framebuffer();
   glBindFramebuffer(GL_FRAMEBUFFER, impl_->draw_fbo);
+  return frame;
+}
+
+FrameView OffscreenGL::read_framebuffer(unsigned int framebuffer) {
+  const int w = impl_->options.width;
+  const int h = impl_->options.height;
+  // Errors the caller's renderer left behind are not this read's to report.
+  while (glGetError() != GL_NO_ERROR) {
+  }
+  const std::string what = "read_framebuffer(" + std::to_string(framebuffer) + ")";
+  if (framebuffer == 0 || glIsFramebuffer(framebuffer) != GL_TRUE) {
+    throw std::runtime_error(what + ": not a framebuffer object of this context");
+  }
+  // The caller's framebuffer is checked, then copied (and resolved, if multisampled) into this context's
+  // own single-sampled one, which is read like read_frame()'s.
+  const auto fail = [&](const std::string& why) {
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    throw std::runtime_error(what + ": " + why);
+  };
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+  if (glCheckFramebufferStatus(GL_READ_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) fail("the framebuffer is incomplete");
+  const auto [attached_w, attached_h] = read_attachment_size();
+  if (attached_w < w || attached_h < h) {
+    fail("its colour attachment is " + std::to_string(attached_w) + "x" + std::to_string(attached_h) +
+         ", smaller than the context's " + std::to_string(w) + "x" + std::to_string(h));
+  }
+  const GLuint copy = impl_->samples > 0 ? impl_->resolve_fbo : impl_->draw_fbo;
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, copy);
+  // A blit honours the scissor test, which renderers (MuJoCo's among them) leave enabled.
+  const GLboolean scissor = glIsEnabled(GL_SCISSOR_TEST);
+  glDisable(GL_SCISSOR_TEST);
+  glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  if (scissor == GL_TRUE) glEnable(GL_SCISSOR_TEST);
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR) {
+    char text[128];
+    std::snprintf(text, sizeof text, "OpenGL error 0x%04x copying it (a multisampled one must be exactly %dx%d)",
+                  error, w, h);
+    fail(text);
+  }
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, copy);
+  const FrameView frame = impl_->read_bound_framebuffer();
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  return frame;
+}
+
+FrameView OffscreenGL::Impl::read_bound_framebuffer() {
+  const int w = options.width;
+  const int h = options.height;
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, bottom_up.data());
   // GL's first row is the bottom one; hand out the top row first.
   const auto row_bytes = static_cast<std::size_t>(w) * 4U;
   for (int y = 0; y < h; ++y) {
-    std::memcpy(impl_->top_down.data() + static_cast<std::size_t>(y) * row_bytes,
-                impl_->bottom_up.data() + static_cast<std::size_t>(h - 1 - y) * row_bytes, row_bytes);
+    std::memcpy(top_down.data() + static_cast<std::size_t>(y) * row_bytes,
+                bottom_up.data() + static_cast<std::size_t>(h - 1 - y) * row_bytes, row_bytes);
   }
-  return FrameView{impl_->top_down.data(), w, h, row_bytes};
+  return FrameView{top_down.data(), w, h, row_bytes};
 }
 
 int OffscreenGL::width() const { return impl_->options.width; }
 int OffscreenGL::height() const { return impl_->options.height; }
 int OffscreenGL::samples() const { return impl_->samples; }
+GLProfile OffscreenGL::profile() const { return impl_->options.profile; }
 
 std::string OffscreenGL::renderer() const {
   const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));

@@ -110,3 +110,77 @@ TEST_CASE("scenes compare equal until the world moves") {
   world.camera.height += 0.1;
   CHECK_FALSE(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
 }
+
+TEST_CASE("a compatibility-profile context draws with fixed-function GL, as MuJoCo 2.x's renderer does") {
+  rfbsim::OffscreenGLOptions options;
+  options.width = 32;
+  options.height = 32;
+  options.samples = 0;
+  options.profile = rfbsim::GLProfile::kCompatibility;
+  rfbsim::OffscreenGL gl(options);
+  INFO(gl.renderer());
+  CHECK(gl.profile() == rfbsim::GLProfile::kCompatibility);
+  gl.begin_frame();
+  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  // glBegin/glEnd and the fixed matrices exist only outside the core profile: a green quad over the left half.
+  glMatrixMode(GL_PROJECTION);
+  glLoadIdentity();
+  glOrtho(0, 32, 0, 32, -1, 1);
+  glColor3f(0.0f, 1.0f, 0.0f);
+  glBegin(GL_QUADS);
+  glVertex2f(0, 0);
+  glVertex2f(16, 0);
+  glVertex2f(16, 32);
+  glVertex2f(0, 32);
+  glEnd();
+  REQUIRE(glGetError() == GL_NO_ERROR);
+  const rfbsim::FrameView frame = gl.read_frame();
+  CHECK(pixel(frame, 4, 4) == std::array<int, 4>{0, 255, 0, 255});
+  CHECK(pixel(frame, 28, 4) == std::array<int, 4>{0, 0, 0, 255});
+  // The default stays 3.3 core.
+  CHECK(rfbsim::OffscreenGL({16, 16, 0, "auto"}).profile() == rfbsim::GLProfile::kCore33);
+}
+
+TEST_CASE("read_framebuffer reads a framebuffer the caller made, top row first, and refuses what it cannot read") {
+  for (const int samples : {0, 4}) {
+    rfbsim::OffscreenGL gl({48, 32, 0, "auto", rfbsim::GLProfile::kCompatibility});
+    gl.begin_frame();
+    // The caller's own FBO (as MuJoCo's mjrContext makes one): a blue picture with a red bottom-left block.
+    GLuint colour = 0;
+    GLuint fbo = 0;
+    glGenRenderbuffers(1, &colour);
+    glBindRenderbuffer(GL_RENDERBUFFER, colour);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, 48, 32);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour);
+    glClearColor(0.0f, 0.0f, 1.0f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glEnable(GL_SCISSOR_TEST);  // left on, as renderers leave it: the read must still copy the whole picture
+    glScissor(0, 0, 8, 4);
+    glClearColor(1.0f, 0.0f, 0.0f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    INFO("samples " << samples);
+    const rfbsim::FrameView frame = gl.read_framebuffer(fbo);
+    CHECK(frame.width == 48);
+    CHECK(frame.height == 32);
+    CHECK(pixel(frame, 0, 31) == std::array<int, 4>{255, 0, 0, 255});
+    CHECK(pixel(frame, 8, 31) == std::array<int, 4>{0, 0, 255, 255});
+    CHECK(pixel(frame, 47, 0) == std::array<int, 4>{0, 0, 255, 255});
+    GLint bound = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &bound);
+    CHECK(bound == static_cast<GLint>(fbo));  // left as the caller had it
+    CHECK(glIsEnabled(GL_SCISSOR_TEST) == GL_TRUE);
+    glDisable(GL_SCISSOR_TEST);
+
+    // Not a framebuffer, the default one, and one smaller than the context: clear errors, no crash.
+    CHECK_THROWS_WITH(gl.read_framebuffer(fbo + 1000), Catch::Contains("not a framebuffer object"));
+    CHECK_THROWS_WITH(gl.read_framebuffer(0), Catch::Contains("not a framebuffer object"));
+    glBindRenderbuffer(GL_RENDERBUFFER, colour);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, 16, 16);
+    CHECK_THROWS_WITH(gl.read_framebuffer(fbo), Catch::Contains("16x16, smaller than the context's 48x32"));
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteRenderbuffers(1, &colour);
+  }
+}

@@ -14,6 +14,7 @@ using rfbsim::manager::manager_usage;
 using rfbsim::manager::ManagerConfig;
 using rfbsim::manager::parse_manager_args;
 using rfbsim::manager::session_kind_name;
+using rfbsim::manager::session_limits;
 using rfbsim::manager::SessionKind;
 using rfbsim::manager::validate_config;
 using rfbsim::test::ScratchDir;
@@ -63,6 +64,7 @@ TEST_CASE("the defaults") {
   CHECK(c.limits.cpu_slack == seconds(60));
   CHECK(std::string(session_kind_name(SessionKind::kSimRfb)) == "sim_rfb");
   CHECK(std::string(session_kind_name(SessionKind::kRfb)) == "rfb");
+  CHECK(std::string(session_kind_name(SessionKind::kX11)) == "x11");
 }
 
 TEST_CASE("an empty command line gives the defaults") {
@@ -213,7 +215,7 @@ TEST_CASE("bad values name the file, the line, the key and what is expected") {
   CHECK_THAT(error("frame_origins: [\"https://user@x.example\"]"), StartsWith(at + "frame_origins: 'https://user@x"));
   CHECK(error("admin_token: 0123456789abcde") == at + "admin_token: must be at least 16 characters");
   CHECK(error("link_secret: short") == at + "link_secret: must be at least 16 characters");
-  CHECK(error("session_kind: docker") == at + "session_kind: expected sim_rfb or rfb");
+  CHECK(error("session_kind: docker") == at + "session_kind: expected sim_rfb, rfb or x11");
   CHECK(error("codec: vp9") == at + "codec: expected auto, jpeg or h264");
   CHECK(error("codec: H264") == at + "codec: expected auto, jpeg or h264");
   CHECK(error("codec: \"\"") == at + "codec: expected auto, jpeg or h264");
@@ -383,7 +385,7 @@ TEST_CASE("bad command lines say what is wrong") {
   CHECK(args_error({"--port", "70000"}) == "--port '70000': expected an integer 0..65535");
   CHECK(args_error({"--max-sessions", "0"}) == "--max-sessions '0': expected an integer 1..10000");
   CHECK(args_error({"--listen-address", "localhost"}) == "--listen-address 'localhost': expected a numeric IPv4 address");
-  CHECK(args_error({"--session-kind", "docker"}) == "--session-kind 'docker': expected sim_rfb or rfb");
+  CHECK(args_error({"--session-kind", "docker"}) == "--session-kind 'docker': expected sim_rfb, rfb or x11");
   CHECK(args_error({"--scenarios", "lab,../x"}) ==
         "--scenarios 'lab,../x': '../x' is not a scenario name (letters, digits, - and _, at most 64), optionally =FILE");
   CHECK(args_error({"--scenarios", ""}) == "--scenarios '': list at least one scenario");
@@ -602,4 +604,74 @@ TEST_CASE("ros settings that cannot work together") {
   c.session_args = {"{port}"};
   CHECK(validate_config(c) ==
         "ros: needs session_kind sim_rfb (a legacy program's template may use {robot_control} itself)");
+}
+
+TEST_CASE("session_kind x11: the x11 section, its flags, and a program without scenarios") {
+  ScratchDir dir;
+  const std::string path = dir.write("x11.yaml", R"(session_kind: x11
+session_command: /usr/bin/glxgears
+session_args: [-geometry, 640x480+0+0]
+x11:
+  geometry: 640x480
+  depth: 16
+  xvnc: /opt/tigervnc/bin/Xvnc
+)");
+  ConfigOutcome outcome = parse_manager_args({"--config", path, "--x11-depth", "24"});
+  REQUIRE(outcome.error.empty());
+  const ManagerConfig& c = outcome.config;
+  CHECK(c.session_kind == SessionKind::kX11);
+  CHECK(c.x11.width == 640);
+  CHECK(c.x11.height == 480);
+  CHECK(c.x11.depth == 24);  // the flag wins over the file
+  CHECK(c.x11.xvnc == "/opt/tigervnc/bin/Xvnc");
+  // Its links need only uid: no scenarios unless the config names some.
+  CHECK(c.scenarios.empty());
+  CHECK(parse_manager_args({"--config", path, "--scenarios", "a,b"}).config.scenarios == Strings{"a", "b"});
+  // The defaults: the size of sim_rfb's picture, 24 bits, Debian's Xvnc.
+  const ManagerConfig defaults;
+  CHECK(defaults.x11.width == 1280);
+  CHECK(defaults.x11.height == 720);
+  CHECK(defaults.x11.depth == 24);
+  CHECK(defaults.x11.xvnc == "/usr/bin/Xvnc");
+  // An rfb program (a simulator linking librfbsim) has none either; sim_rfb keeps its two.
+  CHECK(parse_manager_args({"--session-kind", "rfb", "--session-arg", "{port}"}).config.scenarios.empty());
+  CHECK(parse_manager_args({}).config.scenarios == Strings{"warehouse", "lab"});
+}
+
+TEST_CASE("a bad x11 section or x11 setting says which key and why") {
+  ScratchDir dir;
+  const auto error = [&dir](const std::string& text) {
+    return load_config_file(dir.write("bad.yaml", text), ManagerConfig{}).error;
+  };
+  const std::string at = (dir.path() / "bad.yaml").string() + ":";
+  CHECK(error("x11:\n  geometry: 640\n") ==
+        at + "2: x11.geometry: expected WIDTHxHEIGHT, each 64..8192 (e.g. 1280x720)");
+  CHECK(error("x11:\n  geometry: 99999x480\n") ==
+        at + "2: x11.geometry: expected WIDTHxHEIGHT, each 64..8192 (e.g. 1280x720)");
+  CHECK(error("x11:\n  depth: 8\n") == at + "2: x11.depth: expected 16, 24 or 32");
+  CHECK(error("x11:\n  xvnc: Xvnc\n") == at + "2: x11.xvnc: expected the absolute path of TigerVNC's Xvnc");
+  CHECK(error("x11:\n  display: 3\n") == at + "2: x11.display: unknown setting (known: geometry, depth, xvnc)");
+  CHECK(error("x11: 3\n") == at + "1: x11: expected a mapping (geometry, depth, xvnc)");
+  CHECK(error("x11_depth: 24\n") == at + "1: x11_depth: unknown setting (write it as depth: under x11:)");
+  // The program and its template.
+  CHECK(args_error({"--session-kind", "x11"}) ==
+        "session_kind x11 needs session_command: the X11 program each session runs (e.g. /usr/bin/glxgears)");
+  CHECK(args_error({"--session-kind", "x11", "--session-command", "/usr/bin/xeyes", "--session-arg", "{port}"}) ==
+        "session_kind x11 has no {port}: the program draws on its own display, which the manager serves");
+  CHECK(args_error({"--session-kind", "x11", "--session-command", "/usr/bin/xeyes"}).empty());
+}
+
+TEST_CASE("resource limits per session kind: an x11 program gets more address space unless the config says") {
+  ManagerConfig c;
+  CHECK(session_limits(c).address_space_mb == rfbsim::manager::kDefaultAddressSpaceMb);
+  c.session_kind = SessionKind::kX11;
+  CHECK(session_limits(c).address_space_mb == rfbsim::manager::kDefaultX11AddressSpaceMb);
+  CHECK(session_limits(c).open_files == c.limits.open_files);
+  const ConfigOutcome set = parse_manager_args({"--session-kind", "x11", "--session-command", "/usr/bin/xeyes",
+                                                "--limit-address-space-mb", "2048"});
+  REQUIRE(set.error.empty());
+  CHECK(session_limits(set.config).address_space_mb == 2048);
+#if !defined(__SANITIZE_ADDRESS__)
+  CHECK(rfbsim::manager::kDefaultX11AddressSpaceMb > rfbsim::manager::kDefaultAddressSpaceMb);
+#endif
 }

@@ -417,3 +417,20 @@ TEST_CASE("session_args may not open sim_rfb's rosbridge server nor set ROS's fl
     CHECK_FALSE(session_args_problem({flag, "x"}, SessionKind::kSimRfb).empty());
   }
 }
+
+TEST_CASE("an x11 session runs rfbsim_x11_session with its display and the program's expanded template") {
+  ManagerConfig config;
+  config.session_kind = SessionKind::kX11;
+  config.session_command = "/usr/bin/glxgears";
+  config.scenarios = {};
+  config.x11.width = 640;
+  config.x11.height = 480;
+  config.session_args = {"-geometry", "640x480+0+0", "--log={data_dir}/{uid}.log", "{seed}", "{crowd}"};
+  StartRequest r = request("");
+  LaunchContext context{7, 0, "/data/3-p01", "/run/rfbsim-x/3.sock"};
+  context.xauthority = "/run/rfbsim-x/3.xauth";
+  CHECK(session_arguments(config, r, context) ==
+        Args{"--rfb-socket", "/run/rfbsim-x/3.sock", "--xauthority", "/run/rfbsim-x/3.xauth", "--geometry", "640x480",
+             "--depth", "24", "--xvnc", "/usr/bin/Xvnc", "--ready-fd", "3", "--", "/usr/bin/glxgears", "-geometry",
+             "640x480+0+0", "--log=/data/3-p01/p01.log", "7", ""});
+}

@@ -174,10 +174,17 @@ TEST_CASE("a scenario list entry that is not an identifier cannot be asked for")
   CHECK_FALSE(parsed.request);
 }
 
-TEST_CASE("no scenario offered and none asked for is refused") {
+TEST_CASE("where no scenario is offered a link needs only uid, and one that names a scenario is refused") {
+  // Session kinds rfb and x11 without a scenarios list: a program's scenarios are its own.
   const StartParse parsed = parse_start_request({{"uid", "p01"}}, {});
-  CHECK_FALSE(parsed.request);
-  CHECK(parsed.error == "no scenario is offered here");
+  REQUIRE(parsed.request);
+  CHECK(parsed.request->uid == "p01");
+  CHECK(parsed.request->scenario.empty());
+  const StartParse named = parse_start_request({{"uid", "p01"}, {"scenario", "warehouse"}}, {});
+  CHECK_FALSE(named.request);
+  CHECK(named.error ==
+        "scenario 'warehouse' is not offered here: this server's program has no scenarios, and its links need only uid");
+  CHECK_FALSE(parse_start_request({{"scenario", "x"}}, {}).request);  // still no uid, still refused
 }
 
 TEST_CASE("seeds are whole decimal numbers that fit 64 bits") {
