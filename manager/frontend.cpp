@@ -580,7 +580,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
       respond_json(con, 404, "{\"error\":\"unknown session\"}");
       return;
     }
-    respond_json(con, 200, status_json(*session, std::chrono::system_clock::now(), survey_origins));
+    respond_json(con, 200, status_json(*session, std::chrono::system_clock::now(), survey_origins,
+                                       session_kind_name(config_.session_kind)));
   }
 
   bool admin_allowed(const ConnectionPtr& con) {

@@ -22,7 +22,8 @@ CloseNotice close_notice(SessionState state) {
   }
 }
 
-std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins) {
+std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins,
+                        const std::string& program) {
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.3f", std::chrono::duration<double>(now - session.created).count());
   const auto quoted = [](const std::string& text) { return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\""; };
@@ -34,7 +35,8 @@ std::string status_json(const Session& session, WallTime now, const std::vector<
   return std::string("{\"state\":\"") + state_name(session.state) + "\",\"ends_as\":\"" +
          state_name(coming_state(session)) + "\",\"elapsed_s\":" + seconds + ",\"uid\":\"" + json_escape(session.uid) +
          "\",\"outcome\":" + quoted(session.outcome) + ",\"code\":" + quoted(code) + ",\"survey_origins\":[" +
-         origins + "]}";
+         origins + "]" + (program == "sim_rfb" ? std::string() : ",\"program\":\"" + json_escape(program) + "\"") +
+         "}";
 }
 
 std::string session_json(const Session& s, bool include_token) {

@@ -22,8 +22,10 @@ CloseNotice close_notice(SessionState state);
 /// The page's poll (/s/<token>/status): {"state":..., "ends_as":..., "elapsed_s": seconds since /start,
 /// 3 decimals, "uid":..., "outcome": "completed" | "timeout" | null, "code": the outcome's completion code
 /// or null, "survey_origins": [...]}. The page posts the outcome to its parent window, and only to
-/// `survey_origins` (a watching researcher's page gets none).
-std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins);
+/// `survey_origins` (a watching researcher's page gets none). A session of another program than sim_rfb adds
+/// "program": `program` ("rfb" or "x11", session_kind_name), so that the page does not offer sim_rfb's WASD hint.
+std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins,
+                        const std::string& program = "sim_rfb");
 
 /// One session for the admin API: id, uid, scenario, seed, state, detail, exit status, times, data path, the
 /// after-session copy ("copy_state": "" | "pending" | "done" | "failed", "copy_attempts", "copy_error"), the

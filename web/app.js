@@ -143,6 +143,7 @@ const RESTARTABLE_STATES = new Set(['shutdown', 'crashed', 'failed', 'interrupte
 let statusAvailable = true;  // false once 'status' answered that there is nothing more to ask (see noStatusView)
 let noStatusView = 'none';   // what an unavailable status means: 'none' (sim_rfb's 404) or 'gone' (the manager's)
 let managed = false;         // a manager has answered this page's status at least once
+let programHintSet = false;  // the hint names no WASD: the session runs another program than sim_rfb
 let statusPolling = false;   // the polling loop runs
 let startingSince = null;    // { elapsedS, at }: the session's start-up time as last reported, and when
 let sessionLost = false;     // the balancer said this session's host is gone (see SESSION_LOST_WORDS)
@@ -198,6 +199,11 @@ async function fetchSessionStatus() {
     state.outcome = body.outcome;
     state.completionCode = typeof body.code === 'string' ? body.code : null;
     updateFocus();
+  }
+  // Another program than sim_rfb (the manager's session_kind rfb or x11): its keys are its own, not WASD walking.
+  if (typeof body.program === 'string' && body.program !== 'sim_rfb' && !programHintSet) {
+    programHintSet = true;
+    ui.hint.querySelector('p').textContent = 'Click here to use the keyboard and the mouse';
   }
   survey.update(body);
   startingSince = status.state === 'starting' && status.elapsedS !== null

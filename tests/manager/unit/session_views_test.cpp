@@ -64,6 +64,15 @@ TEST_CASE("the status poll gives the state, what it ends as, and the seconds sin
         R"("survey_origins":[]})");
 }
 
+TEST_CASE("the status poll names another program than sim_rfb, so that the page drops the WASD hint") {
+  Session s = sample();
+  const auto now = s.created + std::chrono::milliseconds(1500);
+  CHECK(rfbsim::manager::status_json(s, now, {}, "x11") ==
+        R"({"state":"running","ends_as":"running","elapsed_s":1.500,"uid":"p-01","outcome":null,"code":null,)"
+        R"("survey_origins":[],"program":"x11"})");
+  CHECK(rfbsim::manager::status_json(s, now, {}, "sim_rfb").find("program") == std::string::npos);
+}
+
 TEST_CASE("the status poll gives the outcome with the code the link carried for it, and the survey origins") {
   Session s = sample();
   s.code_success = "DONE-1";
