@@ -394,9 +394,7 @@ const std::map<std::string, Setting>& settings() {
        }}},
       {"x11_depth", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          int depth = 0;
-         if (!parse_integer(v.front(), 16, 32, depth) || (depth != 16 && depth != 24 && depth != 32)) {
-           return "expected 16, 24 or 32";
-         }
+         if (!parse_integer(v.front(), 16, 24, depth) || (depth != 16 && depth != 24)) return "expected 16 or 24";
          c.x11.depth = depth;
          return "";
        }}},
@@ -531,7 +529,7 @@ std::string manager_usage() {
          "  --ros-robot-control builtin|external  who drives the robot where a link does not say (default builtin)\n"
          "  --ros-cmd-vel-type twist|twist_stamped  the type of the lab's /cmd_vel (default twist)\n"
          "  --x11-geometry WxH      session_kind x11: the display's size (default 1280x720; the x11: section)\n"
-         "  --x11-depth D           its bits per pixel: 16, 24 (default) or 32\n"
+         "  --x11-depth D           its bits per pixel: 16 or 24 (default)\n"
          "  --x11-xvnc PATH         TigerVNC's Xvnc (default /usr/bin/Xvnc)\n"
          "  --sign QUERY            print QUERY with its link signature (needs a link secret) and exit\n";
 }

@@ -17,7 +17,7 @@ namespace rfbsim::manager {
 struct X11Settings {
   int width = 1280;                    ///< the display's and so the picture's size (geometry: WxH)
   int height = 720;
-  int depth = 24;                      ///< 16, 24 or 32 bits per pixel
+  int depth = 24;                      ///< 16 or 24 bits per pixel
   std::string xvnc = "/usr/bin/Xvnc";  ///< TigerVNC's X server (Debian: tigervnc-standalone-server)
 };
 

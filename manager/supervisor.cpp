@@ -20,6 +20,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <thread>
 
 #include "launch_plan.hpp"
@@ -135,6 +136,10 @@ Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::s
   if ((config_.session_kind == SessionKind::kSimRfb && config_.session_socket == "unix") ||
       config_.session_kind == SessionKind::kX11) {
     socket_dir_ = make_socket_dir();
+    // An x11 session's RFB socket and cookie have nowhere else to go that only the manager's user can reach.
+    if (socket_dir_.empty() && config_.session_kind == SessionKind::kX11) {
+      throw std::runtime_error("session_kind x11 needs a private folder for the sessions' sockets and cookies");
+    }
   }
   next_id_ = index_.max_id() + 1;
   for (const auto& [state, count] : index_.count_by_state()) {
@@ -700,7 +705,9 @@ void Supervisor::process_gone(Session& session, int wait_status) {
   if (config_.session_kind == SessionKind::kX11) {
     std::error_code ignored;
     std::filesystem::remove(x11_xauthority_path(session.id), ignored);
-    clean_x11_display(runtime(session.id).x11_display, 0);
+    // Killed, the launcher could not stop its Xvnc in order; exited, it did, and the display's number may already
+    // be another session's.
+    if (WIFSIGNALED(wait_status)) clean_x11_display(runtime(session.id).x11_display, 0);
   }
   save(session, copy_after_commit(session));
   log_session(session, std::string(state_name(final_state)) + " (" + session.exit_status + ")");

@@ -150,14 +150,9 @@ int run_session(const SessionOptions& options) {
   for (const int sig : {SIGCHLD, SIGTERM, SIGINT, SIGHUP}) sigaddset(&watched, sig);
   ::sigprocmask(SIG_BLOCK, &watched, nullptr);
   ::signal(SIGPIPE, SIG_IGN);  // a manager that has gone makes the ready write fail, not kill us
-  const Fd signals(::signalfd(-1, &watched, SFD_CLOEXEC | SFD_NONBLOCK));
-  if (signals.fd < 0) {
-    say(std::string("signalfd: ") + std::strerror(errno));
-    return 1;
-  }
-  bool stop_requested = false;
 
-  // The manager's pipe is for us alone: neither Xvnc nor the program inherits it.
+  // The manager's pipe is for us alone: neither Xvnc nor the program inherits it. Checked before any descriptor
+  // of ours is made, which would otherwise take a closed fd's number and pass for it.
   Fd ready;
   if (options.ready_fd >= 0) {
     if (::fcntl(options.ready_fd, F_SETFD, FD_CLOEXEC) != 0) {
@@ -166,6 +161,13 @@ int run_session(const SessionOptions& options) {
     }
     ready.fd = options.ready_fd;
   }
+
+  const Fd signals(::signalfd(-1, &watched, SFD_CLOEXEC | SFD_NONBLOCK));
+  if (signals.fd < 0) {
+    say(std::string("signalfd: ") + std::strerror(errno));
+    return 1;
+  }
+  bool stop_requested = false;
 
   // Absolute, so that the program finds it whatever directory it moves to.
   std::error_code ec;
@@ -236,6 +238,13 @@ int run_session(const SessionOptions& options) {
   display_pipe.reset();
   leftovers.display = display;
 
+  // Xvnc that exited by itself removed its display's files; only one that was killed leaves them (and then the
+  // number may be another server's by the time we look, so a clean exit is not looked after).
+  const auto stop_xvnc = [&] {
+    const int status = stop_child(xvnc, kXvncGrace, signals.fd, stop_requested);
+    if (WIFEXITED(status)) leftovers.display = -1;
+  };
+
   // The program on that display, with the cookie; its output goes where ours goes.
   pid_t program = -1;
   {
@@ -248,7 +257,7 @@ int run_session(const SessionOptions& options) {
       program = spawn_child(spec);
     } catch (const std::exception& error) {
       say(error.what());
-      stop_child(xvnc, kXvncGrace, signals.fd, stop_requested);
+      stop_xvnc();
       return 1;
     }
   }
@@ -264,20 +273,24 @@ int run_session(const SessionOptions& options) {
 
   // Live as long as both.
   for (;;) {
+    // The manager signals the whole group: a stop that comes with the program's exit is still a stop (exit 0).
+    drain_signals(signals.fd, stop_requested);
     int status = 0;
-    if (::waitpid(program, &status, WNOHANG) == program) {
-      stop_child(xvnc, kXvncGrace, signals.fd, stop_requested);
+    const bool program_ended = ::waitpid(program, &status, WNOHANG) == program;
+    if (stop_requested) {
+      if (!program_ended) stop_child(program, kProgramGrace, signals.fd, stop_requested);
+      stop_xvnc();
+      return 0;
+    }
+    if (program_ended) {
+      stop_xvnc();
       return exit_code(status);
     }
     if (::waitpid(xvnc, &status, WNOHANG) == xvnc) {
       say("Xvnc ended (" + describe(status) + "); stopping " + options.program.front() + "; see " + kXvncLog);
+      if (WIFEXITED(status)) leftovers.display = -1;
       stop_child(program, kProgramGrace, signals.fd, stop_requested);
       return 1;
-    }
-    if (stop_requested) {
-      stop_child(program, kProgramGrace, signals.fd, stop_requested);
-      stop_child(xvnc, kXvncGrace, signals.fd, stop_requested);
-      return 0;
     }
     pollfd watch{signals.fd, POLLIN, 0};
     ::poll(&watch, 1, -1);

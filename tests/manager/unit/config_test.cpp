@@ -648,7 +648,8 @@ TEST_CASE("a bad x11 section or x11 setting says which key and why") {
         at + "2: x11.geometry: expected WIDTHxHEIGHT, each 64..8192 (e.g. 1280x720)");
   CHECK(error("x11:\n  geometry: 99999x480\n") ==
         at + "2: x11.geometry: expected WIDTHxHEIGHT, each 64..8192 (e.g. 1280x720)");
-  CHECK(error("x11:\n  depth: 8\n") == at + "2: x11.depth: expected 16, 24 or 32");
+  CHECK(error("x11:\n  depth: 8\n") == at + "2: x11.depth: expected 16 or 24");
+  CHECK(error("x11:\n  depth: 32\n") == at + "2: x11.depth: expected 16 or 24");
   CHECK(error("x11:\n  xvnc: Xvnc\n") == at + "2: x11.xvnc: expected the absolute path of TigerVNC's Xvnc");
   CHECK(error("x11:\n  display: 3\n") == at + "2: x11.display: unknown setting (known: geometry, depth, xvnc)");
   CHECK(error("x11: 3\n") == at + "1: x11: expected a mapping (geometry, depth, xvnc)");
