@@ -2,9 +2,7 @@
 // rfbsim_x11_session as a real process: real Xvnc, our key-echo X11 program, a libvncclient client on the 0600
 // unix socket. Each session's life ends one way (SIGTERM, the program exiting, Xvnc dying, SIGKILL of the whole
 // group) and nothing may be left: no process of the group, no X lock or socket, no RFB socket, no Xauthority.
-#include <sys/socket.h>
 #include <sys/stat.h>
-#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,7 +10,6 @@
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
-#include <fstream>
 #include <optional>
 #include <string>
 #include <thread>
@@ -21,12 +18,14 @@
 #include "launcher_run.hpp"
 #include "rfb_test_client.hpp"
 #include "scratch_dir.hpp"
+#include "x11_display_check.hpp"
 #include "x11_display.hpp"
 
 using namespace std::chrono_literals;
 using rfbsim::test::LauncherRun;
 using rfbsim::test::path_exists;
 using rfbsim::test::ScratchDir;
+using rfbsim::test::display_left_behind;
 
 namespace {
 
@@ -52,33 +51,6 @@ int display_from_ready(const std::optional<std::string>& text, const ScratchDir&
   const std::string first = "ready unix " + dir.path("rfb.sock") + "\nx11 display ";
   if (ready.rfind(first, 0) != 0 || ready.empty() || ready.back() != '\n') return -1;
   return std::stoi(ready.substr(first.size()));
-}
-
-// Whether something accepts connections on the unix socket at `path`.
-bool socket_accepts(const std::string& path) {
-  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) return false;
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  path.copy(address.sun_path, sizeof(address.sun_path) - 1);
-  const bool accepted = ::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
-  ::close(fd);
-  return accepted;
-}
-
-// Files of `display` that outlived their server: a lock naming a dead pid, or an X socket nobody accepts on.
-// Tests run in parallel (ctest -j), and Xvnc -displayfd takes the lowest free number, so another test's live
-// server may hold the same display by now: its files are not left behind.
-bool display_left_behind(int display) {
-  const std::string lock = rfbsim::x11::display_lock_path(display);
-  if (path_exists(lock)) {
-    std::ifstream in(lock);
-    int pid = 0;
-    in >> pid;
-    if (pid <= 0 || ::kill(pid, 0) != 0) return true;
-  }
-  const std::string socket = rfbsim::x11::display_socket_path(display);
-  return path_exists(socket) && !socket_accepts(socket);
 }
 
 // What a session leaves when it ended well: nothing.

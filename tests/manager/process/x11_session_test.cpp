@@ -6,9 +6,7 @@
 // Built where CMake finds Xvnc and Xlib (tests/manager/process/CMakeLists.txt).
 #include <catch2/catch.hpp>
 
-#include <sys/socket.h>
 #include <sys/stat.h>
-#include <sys/un.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,12 +20,14 @@
 #include "manager_process.hpp"
 #include "rfb_test_client.hpp"
 #include "ws_rfb_bridge.hpp"
+#include "x11_display_check.hpp"
 
 using namespace std::chrono_literals;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::RfbTestClient;
 using rfbsim::test::TempDir;
 using rfbsim::test::WsRfbBridge;
+using rfbsim::test::display_left_behind;
 using rfbsim::test::token_from_redirect;
 
 namespace {
@@ -54,31 +54,6 @@ int display_of(const std::string& data_path) {
   const std::size_t at = log.find("display :");
   if (at == std::string::npos) return -1;
   return std::atoi(log.c_str() + at + 9);
-}
-
-// Whether something accepts connections on the unix socket at `path`.
-bool socket_accepts(const std::string& path) {
-  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) return false;
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  path.copy(address.sun_path, sizeof(address.sun_path) - 1);
-  const bool accepted = ::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
-  ::close(fd);
-  return accepted;
-}
-
-// A display whose files outlived their X server: a lock file whose pid is gone, or an X socket nobody accepts
-// on. (A live server of another test may hold the same number by now: its files are not left behind.)
-bool display_left_behind(int display) {
-  const std::string lock = "/tmp/.X" + std::to_string(display) + "-lock";
-  const std::string socket = "/tmp/.X11-unix/X" + std::to_string(display);
-  std::error_code ec;
-  if (std::filesystem::exists(lock, ec)) {
-    const int pid = std::atoi(read_file(lock).c_str());
-    if (pid <= 0 || !rfbsim::test::process_exists(pid)) return true;
-  }
-  return std::filesystem::exists(socket, ec) && !socket_accepts(socket);
 }
 
 // The centre pixel of the client's picture as 0xRRGGBB.
