@@ -19,9 +19,9 @@ import os from 'node:os';
 import path from 'node:path';
 
 import {
-  PIXEL_CHANGE_THRESHOLD, changedFraction, check, launchBrowser, log, onCleanup, openPage, pageState,
-  parseManagerArgs, poll, prepare, recordPage, runTest, serveHtmlPage, sleep, snapshot, startSim, stopSimCleanly,
-  waitForConnection, waitForPicture,
+  PIXEL_CHANGE_THRESHOLD, changedFraction, check, childrenOf, launchBrowser, log, onCleanup, openPage, pageState,
+  parseManagerArgs, poll, prepare, procInfo, recordPage, runTest, serveHtmlPage, sleep, snapshot, startSim,
+  stopSimCleanly, waitForConnection, waitForPicture,
 } from './e2e_support.mjs';
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -72,35 +72,6 @@ function tokenOf(url, what) {
   check(parsed.origin === new URL(base).origin && match,
         `${what}: expected ${new URL(base).origin}/s/<32 hex digits>/, got ${url}`);
   return match[1];
-}
-
-// The processes whose parent is ppid, from /proc: [{ pid, comm, pgrp, start }].
-function childrenOf(ppid) {
-  const out = [];
-  for (const entry of fs.readdirSync('/proc')) {
-    if (!/^\d+$/.test(entry)) {
-      continue;
-    }
-    const info = procInfo(Number(entry));
-    if (info && info.ppid === ppid) {
-      out.push(info);
-    }
-  }
-  return out;
-}
-
-// /proc/PID/stat as { pid, comm, state, ppid, pgrp, start }, or null when there is no such process.
-function procInfo(pid) {
-  let stat;
-  try {
-    stat = fs.readFileSync(`/proc/${pid}/stat`, 'utf8');
-  } catch {
-    return null;
-  }
-  const close = stat.lastIndexOf(')');
-  const fields = stat.slice(close + 2).split(' ');
-  return { pid, comm: stat.slice(stat.indexOf('(') + 1, close), state: fields[0], ppid: Number(fields[1]),
-           pgrp: Number(fields[2]), start: fields[19] };
 }
 
 // Whether a process seen before (same pid and start time) is still there.

@@ -19,8 +19,9 @@ import os from 'node:os';
 import path from 'node:path';
 
 import {
-  PIXEL_CHANGE_THRESHOLD, changedFraction, check, launchBrowser, log, onCleanup, openPage, parseManagerArgs, poll,
-  prepare, recordPage, runTest, sleep, snapshot, startSim, stopSimCleanly, waitForConnection, waitForPicture,
+  PIXEL_CHANGE_THRESHOLD, changedFraction, check, childrenOf, launchBrowser, log, onCleanup, openPage,
+  parseManagerArgs, poll, prepare, procInfo, recordPage, runTest, sleep, snapshot, startSim, stopSimCleanly,
+  waitForConnection, waitForPicture,
 } from './e2e_support.mjs';
 
 const HOLD_W_MS = 800;                  // how long W is held down, wall time
@@ -31,33 +32,10 @@ const TOKEN_PATH = /^\/s\/([0-9a-f]{32})\/$/;
 
 const env = parseManagerArgs('e2e_mujoco.mjs');
 
-// The pids of the processes whose parent is ppid (from /proc).
-function childrenOf(ppid) {
-  const out = [];
-  for (const entry of fs.readdirSync('/proc')) {
-    if (!/^\d+$/.test(entry)) {
-      continue;
-    }
-    try {
-      const stat = fs.readFileSync(`/proc/${entry}/stat`, 'utf8');
-      if (Number(stat.slice(stat.lastIndexOf(')') + 2).split(' ')[1]) === ppid) {
-        out.push(Number(entry));
-      }
-    } catch {
-      // gone meanwhile
-    }
-  }
-  return out;
-}
-
 // Whether a process with this pid still runs (a zombie does not count).
 function running(pid) {
-  try {
-    const stat = fs.readFileSync(`/proc/${pid}/stat`, 'utf8');
-    return stat.slice(stat.lastIndexOf(')') + 2)[0] !== 'Z';
-  } catch {
-    return false;
-  }
+  const info = procInfo(pid);
+  return info !== null && info.state !== 'Z';
 }
 
 async function main() {
@@ -108,8 +86,8 @@ async function main() {
   check(parsed.origin === new URL(base).origin && TOKEN_PATH.test(parsed.pathname),
         `the link led to ${page.url()}, expected ${new URL(base).origin}/s/<32 hex digits>/`);
   await waitForConnection(page);
-  for (const pid of childrenOf(manager.child.pid)) {
-    sessionPids.add(pid);
+  for (const child of childrenOf(manager.child.pid)) {
+    sessionPids.add(child.pid);
   }
   const picture = await waitForPicture(page, 'first');
   log(`canvas ${picture.width}x${picture.height}, ${picture.colours}+ colours, luma range ` +

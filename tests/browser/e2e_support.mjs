@@ -51,6 +51,35 @@ export function check(condition, message) {
 
 export const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
+// /proc/PID/stat as { pid, comm, state, ppid, pgrp, start }, or null when there is no such process.
+export function procInfo(pid) {
+  let stat;
+  try {
+    stat = fs.readFileSync(`/proc/${pid}/stat`, 'utf8');
+  } catch {
+    return null;
+  }
+  const close = stat.lastIndexOf(')');
+  const fields = stat.slice(close + 2).split(' ');
+  return { pid, comm: stat.slice(stat.indexOf('(') + 1, close), state: fields[0], ppid: Number(fields[1]),
+           pgrp: Number(fields[2]), start: fields[19] };
+}
+
+// The processes whose parent is ppid, from /proc: procInfo objects.
+export function childrenOf(ppid) {
+  const out = [];
+  for (const entry of fs.readdirSync('/proc')) {
+    if (!/^\d+$/.test(entry)) {
+      continue;
+    }
+    const info = procInfo(Number(entry));
+    if (info && info.ppid === ppid) {
+      out.push(info);
+    }
+  }
+  return out;
+}
+
 const STREAM_END_TIMEOUT_MS = 2000;   // a log file gets this long to be written out when it is closed
 
 // Ends a write stream and resolves once what was written reached the file (or it failed, or after

@@ -25,7 +25,7 @@ import { fileURLToPath } from 'node:url';
 
 import {
   CheckFailed, PIXEL_CHANGE_THRESHOLD, changedFraction, check, launchBrowser, log, onCleanup, openPage, pageState,
-  parseManagerArgs, poll, prepare, recordPage, runTest, sleep, snapshot, startSim, stopSimCleanly,
+  parseManagerArgs, poll, prepare, procInfo, recordPage, runTest, sleep, snapshot, startSim, stopSimCleanly,
   waitForConnection, waitForPicture,
 } from './e2e_support.mjs';
 
@@ -54,20 +54,6 @@ const demoConfig = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '.
 function request(base, pathname, { method = 'GET', admin = false } = {}) {
   const headers = admin ? { Authorization: `Bearer ${ADMIN_TOKEN}`, 'X-Rfbsim-Admin': '1' } : {};
   return fetch(new URL(pathname, base), { method, headers, redirect: 'manual', signal: AbortSignal.timeout(5000) });
-}
-
-// /proc/PID/stat as { pid, comm, state, ppid, start }, or null when there is no such process.
-function procInfo(pid) {
-  let stat;
-  try {
-    stat = fs.readFileSync(`/proc/${pid}/stat`, 'utf8');
-  } catch {
-    return null;
-  }
-  const close = stat.lastIndexOf(')');
-  const fields = stat.slice(close + 2).split(' ');
-  return { pid, comm: stat.slice(stat.indexOf('(') + 1, close), state: fields[0], ppid: Number(fields[1]),
-           start: fields[19] };
 }
 
 // Every process below pid (children, their children, ...), from one pass over /proc.

@@ -12,11 +12,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <thread>
 
+#include "file_text.hpp"
 #include "manager_process.hpp"
 #include "rfb_test_client.hpp"
 #include "ws_rfb_bridge.hpp"
@@ -28,6 +27,7 @@ using rfbsim::test::RfbTestClient;
 using rfbsim::test::TempDir;
 using rfbsim::test::WsRfbBridge;
 using rfbsim::test::display_left_behind;
+using rfbsim::test::file_text;
 using rfbsim::test::token_from_redirect;
 
 namespace {
@@ -41,16 +41,9 @@ std::vector<std::string> x11_flags(std::vector<std::string> extra = {}) {
   return flags;
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
-}
-
 // The display the session's launcher reported in its session.log ("display :N"); -1 if none yet.
 int display_of(const std::string& data_path) {
-  const std::string log = read_file(data_path + "/session.log");
+  const std::string log = file_text(data_path + "/session.log");
   const std::size_t at = log.find("display :");
   if (at == std::string::npos) return -1;
   return std::atoi(log.c_str() + at + 9);
@@ -67,7 +60,7 @@ std::uint32_t centre_pixel(const RfbTestClient& client) {
 // The files in the manager's private socket folder (the relay's and Xauthority's), found through the launcher's
 // own command line: its --rfb-socket argument.
 std::string rfb_socket_of(pid_t launcher) {
-  std::string cmdline = read_file("/proc/" + std::to_string(launcher) + "/cmdline");
+  std::string cmdline = file_text("/proc/" + std::to_string(launcher) + "/cmdline");
   std::vector<std::string> args;
   for (std::size_t at = 0; at < cmdline.size();) {
     const std::size_t end = cmdline.find('\0', at);
@@ -126,7 +119,7 @@ TEST_CASE("an X11 program served through the manager: its picture, a key reachin
   client.send_key('w', true);
   client.send_key('w', false);
   CHECK(client.pump_until([&] { return centre_pixel(client) != before; }, 10s));
-  CHECK(rfbsim::test::eventually([&] { return read_file(row->data_path + "/session.log").find("key w") !=
+  CHECK(rfbsim::test::eventually([&] { return file_text(row->data_path + "/session.log").find("key w") !=
                                               std::string::npos; }, 10s));
   // Xvnc's own log is part of the session's folder.
   CHECK(std::filesystem::exists(row->data_path + "/xvnc.log"));
