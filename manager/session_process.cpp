@@ -23,6 +23,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "child_signals.hpp"
+
 extern char** environ;
 
 namespace rfbsim::manager {
@@ -142,13 +144,7 @@ struct OwnedFd {
   if (::getppid() != parent) ::_exit(126);
 
   // Signals: the manager blocks or handles some; the session starts with a clean slate.
-  sigset_t none;
-  sigemptyset(&none);
-  ::sigprocmask(SIG_SETMASK, &none, nullptr);
-  struct sigaction default_action {};
-  default_action.sa_handler = SIG_DFL;
-  sigemptyset(&default_action.sa_mask);
-  for (const int sig : {SIGPIPE, SIGINT, SIGTERM, SIGCHLD, SIGHUP}) ::sigaction(sig, &default_action, nullptr);
+  rfbsim::x11::reset_signals_for_exec();
 
   // Never above the hard limit we inherited: without privileges raising it fails, and a limit lower than asked
   // for is still a limit (a manager under `ulimit -Hn 512` must still start sessions).

@@ -18,6 +18,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "child_signals.hpp"
+
 namespace rfbsim::x11 {
 
 namespace {
@@ -33,13 +35,7 @@ std::vector<char*> pointers(std::vector<std::string>& strings) {
 [[noreturn]] void run_child(const ChildSpec& spec, char* const* argv, char* const* envp, int error_fd, pid_t parent) {
   // The launcher blocks its signals for its signalfd and ignores SIGPIPE; the child starts clean (a blocked or
   // ignored signal would survive the exec).
-  sigset_t none;
-  sigemptyset(&none);
-  ::sigprocmask(SIG_SETMASK, &none, nullptr);
-  struct sigaction default_action {};
-  default_action.sa_handler = SIG_DFL;
-  sigemptyset(&default_action.sa_mask);
-  for (const int sig : {SIGPIPE, SIGINT, SIGTERM, SIGCHLD, SIGHUP}) ::sigaction(sig, &default_action, nullptr);
+  rfbsim::x11::reset_signals_for_exec();
 
   // Do not outlive the launcher: its clean-up would never run for us.
   if (spec.death_signal != 0) {
