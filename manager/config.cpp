@@ -90,6 +90,19 @@ Apply text(std::string ManagerConfig::*field, std::size_t min_length = 1) {
   };
 }
 
+// A file of the ros section, made absolute (a session runs in its own folder) and checked by `problem`.
+Apply ros_file(std::string RosSettings::*field, std::string (*problem)(const std::string& path)) {
+  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+    if (v.front().empty()) return "must not be empty";
+    std::error_code ec;
+    const std::string path = std::filesystem::absolute(v.front(), ec).string();
+    if (ec) return "cannot make " + v.front() + " absolute: " + ec.message();
+    if (std::string found = problem(path); !found.empty()) return found;
+    c.ros.*field = path;
+    return "";
+  };
+}
+
 Apply boolean(bool ManagerConfig::*field) {
   return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
     if (v.front() == "true" || v.front() == "yes" || v.front() == "1") {
@@ -335,24 +348,8 @@ const std::map<std::string, Setting>& settings() {
          c.ros.connect = v.front();
          return "";
        }}},
-      {"ros_token_file", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.front().empty()) return "must not be empty";
-         std::error_code ec;
-         const std::string path = std::filesystem::absolute(v.front(), ec).string();
-         if (ec) return "cannot make " + v.front() + " absolute: " + ec.message();
-         if (std::string problem = token_file_problem(path); !problem.empty()) return problem;
-         c.ros.token_file = path;
-         return "";
-       }}},
-      {"ros_ca_file", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.front().empty()) return "must not be empty";
-         std::error_code ec;
-         const std::string path = std::filesystem::absolute(v.front(), ec).string();
-         if (ec) return "cannot make " + v.front() + " absolute: " + ec.message();
-         if (std::string problem = ca_file_problem(path); !problem.empty()) return problem;
-         c.ros.ca_file = path;
-         return "";
-       }}},
+      {"ros_token_file", {false, ros_file(&RosSettings::token_file, token_file_problem)}},
+      {"ros_ca_file", {false, ros_file(&RosSettings::ca_file, ca_file_problem)}},
       {"ros_namespace", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          if (!is_ros_name(v.front())) {
            return "expected a ROS name such as /rfbsim: '/', then segments of letters, digits and '_' that start "
