@@ -11,15 +11,14 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "accept_pause.hpp"
+
 namespace rfbsim::manager {
 
 namespace {
 
 namespace asio = boost::asio;
 
-// After a failed accept (EMFILE), wait this long before the next: accepting at once would spin on the I/O
-// thread that every relay shares.
-constexpr auto kAcceptPause = std::chrono::milliseconds(100);
 // How long a peer may keep a connection open after our line, and how much it may send meanwhile.
 constexpr auto kLingerLimit = std::chrono::seconds(2);
 constexpr std::size_t kMaxPeerBytes = 4096;

@@ -26,6 +26,7 @@
 #include "session_views.hpp"
 #include "start_request.hpp"
 #include "static_files.hpp"
+#include "unix_time.hpp"
 #include "web_policy.hpp"
 
 namespace rfbsim::manager {
@@ -384,10 +385,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
              "The link has no expiry time. Please use the exact link your survey gave you.");
       return;
     }
-    const auto unix_now = std::chrono::duration_cast<std::chrono::seconds>(
-                              std::chrono::system_clock::now().time_since_epoch())
-                              .count();
-    if (parsed.request->expires_at && *parsed.request->expires_at < static_cast<std::uint64_t>(unix_now)) {
+    if (parsed.request->expires_at && *parsed.request->expires_at < static_cast<std::uint64_t>(unix_seconds_now())) {
       refuse(con, 410, Rejection::kBadSignature, "This link has expired",
              "The study link is no longer valid. Please go back to the survey or contact the researcher.");
       return;

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "accept_pause.hpp"
 #include "client_address.hpp"
 #include "config.hpp"
 #include "connection_limits.hpp"
@@ -25,9 +26,6 @@ namespace rfbsim::manager {
 
 namespace intake_detail {
 
-// After a failed accept (EMFILE: no descriptor left), how long to wait before the next: accepting at once
-// would fail at once again, a busy loop on the I/O thread that every session's relay shares.
-constexpr auto kAcceptPause = std::chrono::milliseconds(100);
 // Descriptors kept free of public connections for the manager itself: the index, logs, and per live session
 // its relays' upstream sockets, its ready pipe and its spawn.
 constexpr std::size_t kReservedDescriptors = 64;
@@ -136,10 +134,10 @@ class PublicIntake {
     metrics_.count_accept_error();
     if (!paused_) {
       std::fprintf(stderr, "[manager] accepting connections failed (%s); pausing %lld ms between tries\n", why.c_str(),
-                   static_cast<long long>(intake_detail::kAcceptPause.count()));
+                   static_cast<long long>(kAcceptPause.count()));
     }
     paused_ = true;
-    pause_.expires_after(intake_detail::kAcceptPause);
+    pause_.expires_after(kAcceptPause);
     pause_.async_wait([this](const boost::system::error_code& ec) {
       if (!ec) accept_next();
     });

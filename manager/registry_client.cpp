@@ -10,6 +10,7 @@
 #include <cstdio>
 
 #include "tokens.hpp"
+#include "unix_time.hpp"
 
 namespace rfbsim::manager {
 
@@ -27,10 +28,6 @@ constexpr int kRetryPauseMaxMs = 150;
 // failed connection, at most this often (a restarted host may have a new address).
 constexpr auto kResolveRetry = std::chrono::seconds(2);
 constexpr auto kResolveRefresh = std::chrono::seconds(5);
-
-long long unix_now() {
-  return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 }  // namespace
 
@@ -173,7 +170,7 @@ void RegistryClient::run_phase(const std::shared_ptr<Round>& round, MessageKind 
   phase->request.uid = round->uid;
   phase->request.ballot = round->ballot;
   phase->request.nonce = round->nonce;
-  phase->request.unix_time = unix_now();
+  phase->request.unix_time = unix_seconds_now();
   if (kind == MessageKind::kAccept) phase->request.value = round->proposal;
 
   // One timeout for the whole phase: whoever has not answered by then counts as silent.

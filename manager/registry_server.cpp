@@ -14,7 +14,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "accept_pause.hpp"
 #include "uid_registry.hpp"
+#include "unix_time.hpp"
 
 namespace rfbsim::manager {
 
@@ -27,13 +29,6 @@ using asio::ip::tcp;
 constexpr auto kReadTimeout = std::chrono::seconds(2);
 // Connections served at once; more are closed at accept (a proposer treats that as a peer that is down).
 constexpr int kMaxConnections = 64;
-// After a failed accept (EMFILE), wait this long before the next: accepting at once would spin on the I/O
-// thread (the same pause as agent_check.cpp's).
-constexpr auto kAcceptPause = std::chrono::milliseconds(100);
-
-long long unix_now() {
-  return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 }  // namespace
 
@@ -148,7 +143,7 @@ void RegistryServer::serve(tcp::socket socket) {
         const std::string line(asio::buffers_begin(data), asio::buffers_begin(data) + static_cast<long>(length) - 1);
         const MessageParse parsed = parse_message(line, key_);
         const std::string problem =
-            parsed.message ? request_problem(*parsed.message, self_, peers_, unix_now()) : parsed.error;
+            parsed.message ? request_problem(*parsed.message, self_, peers_, unix_seconds_now()) : parsed.error;
         if (!problem.empty()) {
           // A bad hmac from a real peer means another secret or another cluster_peers list on that host.
           std::fprintf(stderr, "[registry] refused a request: %s%s\n", problem.c_str(),

@@ -6,7 +6,8 @@
 #   scripts/run-survey-demo.sh [sim_manager options, e.g. --session-arg --time-limit --session-arg 60]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
+# Only what the survey demo runs, and sim_report for its data afterwards.
+scripts/setup.sh --target sim_manager --target sim_report
 survey_port=8000
 node scripts/serve-survey-demo.mjs "$survey_port" &
 survey_pid=$!

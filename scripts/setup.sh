@@ -1,18 +1,21 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
 # Installs what rfbsim needs on Debian 12 (only what is missing), installs the page's npm packages from
-# the lock file, and builds. Used by run-demo.sh and test.sh; safe to run again.
-#   scripts/setup.sh [--with-browser] [--build-dir DIR] [extra cmake -D options...]
+# the lock file, and builds: everything, or only the --target(s) named (the demos build just what they run).
+# Used by run-demo.sh and test.sh; safe to run again, and quick when nothing changed.
+#   scripts/setup.sh [--with-browser] [--build-dir DIR] [--target NAME]... [extra cmake -D options...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 with_browser=0
 build_dir=build
 cmake_args=()
+targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --with-browser) with_browser=1 ;;
     --build-dir) build_dir="$2"; shift ;;
+    --target) targets+=(--target "$2"); shift ;;
     -D*) cmake_args+=("$1") ;;
     *) echo "setup.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
@@ -53,7 +56,11 @@ if [ ! -f web/node_modules/.package-lock.json ] || ! cmp -s web/package-lock.jso
   cp web/package-lock.json web/.installed-lock.json
 fi
 
-generator=()
-command -v ninja >/dev/null 2>&1 && [ ! -f "$build_dir/CMakeCache.txt" ] && generator=(-G Ninja)
-cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo "${cmake_args[@]}"
-cmake --build "$build_dir" -j "$(nproc)"
+# Configure once; later builds re-run CMake by themselves when a CMakeLists.txt changes, so a second start of a
+# demo goes straight to the (empty) build. New -D options configure again.
+if [ ! -f "$build_dir/CMakeCache.txt" ] || [ ${#cmake_args[@]} -gt 0 ]; then
+  generator=()
+  command -v ninja >/dev/null 2>&1 && [ ! -f "$build_dir/CMakeCache.txt" ] && generator=(-G Ninja)
+  cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo "${cmake_args[@]}"
+fi
+cmake --build "$build_dir" -j "$(nproc)" "${targets[@]}"

@@ -10,13 +10,12 @@
 #include <memory>
 #include <string>
 
+#include "map/c_file.hpp"
+
 namespace rfbsim::sim {
 namespace {
 
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-using File = std::unique_ptr<std::FILE, FileCloser>;
+using File = CFile;
 
 // fopen rather than ifstream: errno after fopen is reliable, and libpng wants a FILE* anyway.
 File open_file(const std::filesystem::path& file) {

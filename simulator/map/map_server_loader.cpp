@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 
+#include "map/c_file.hpp"
 #include "map/yaml_limits.hpp"
 
 namespace rfbsim::sim {
@@ -64,15 +65,11 @@ class YamlDoc {
   YAML::Node root_;
 };
 
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-
 // Reads the whole YAML file; yaml-cpp's own LoadFile would not say why a file cannot be opened.
 YAML::Node parse_yaml_file(const std::filesystem::path& file) {
   const std::string name = file.string();
   errno = 0;
-  const std::unique_ptr<std::FILE, FileCloser> f(std::fopen(file.c_str(), "rb"));
+  const CFile f(std::fopen(file.c_str(), "rb"));
   if (!f) throw MapLoadError(name + ": cannot open: " + std::strerror(errno));
   std::string text;
   char buffer[4096];

@@ -19,7 +19,7 @@ namespace {
 
 // u_rect: the image's left, top, width and height in frame pixels (y down). The quad covers exactly those
 // pixels, so each one's fragment is shaded once.
-constexpr const char* kVertexShader = R"(#version 330 core
+constexpr const char* kHudVertexShader = R"(#version 330 core
 uniform vec4 u_rect;
 uniform vec2 u_frame;
 void main() {
@@ -30,7 +30,7 @@ void main() {
 )";
 
 // GL counts rows up from the bottom; the images count them down from the top (texture row 0 = top row).
-constexpr const char* kFragmentShader = R"(#version 330 core
+constexpr const char* kHudFragmentShader = R"(#version 330 core
 uniform sampler2D u_image;
 uniform vec4 u_rect;
 uniform vec2 u_frame;
@@ -107,7 +107,7 @@ struct GlHudLayer::Impl {
 };
 
 GlHudLayer::GlHudLayer() : impl_(std::make_unique<Impl>()) {
-  impl_->program = link_gl_program(kVertexShader, kFragmentShader, "HUD shader");
+  impl_->program = link_gl_program(kHudVertexShader, kHudFragmentShader, "HUD shader");
   impl_->u_rect = glGetUniformLocation(impl_->program, "u_rect");
   impl_->u_frame = glGetUniformLocation(impl_->program, "u_frame");
   impl_->u_image = glGetUniformLocation(impl_->program, "u_image");

@@ -28,7 +28,7 @@ namespace {
 
 // Lighting: a hemisphere ambient (sky above, floor bounce below) plus one sun, and distance fog.
 // Both make depth read on a flat screen: surfaces facing away are darker, far things fade into the sky.
-constexpr const char* kVertexShader = R"(#version 330 core
+constexpr const char* kSceneVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
 // Per instance (InstanceAttributes below).
@@ -51,7 +51,7 @@ void main() {
 }
 )";
 
-constexpr const char* kFragmentShader = R"(#version 330 core
+constexpr const char* kSceneFragmentShader = R"(#version 330 core
 in vec3 v_world;
 in vec3 v_normal;
 flat in vec4 v_color;
@@ -193,7 +193,7 @@ struct GlRenderer::Impl {
 };
 
 GlRenderer::GlRenderer() : impl_(std::make_unique<Impl>()) {
-  impl_->program = link_gl_program(kVertexShader, kFragmentShader, "shader");
+  impl_->program = link_gl_program(kSceneVertexShader, kSceneFragmentShader, "shader");
   const auto uniform = [&](const char* name) { return glGetUniformLocation(impl_->program, name); };
   impl_->u_view_projection = uniform("u_view_projection");
   impl_->u_sun = uniform("u_sun");

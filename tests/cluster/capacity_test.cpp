@@ -33,7 +33,7 @@ bool is_busy_page(const StartResult& result) {
 
 TEST_CASE("a full host sends new uids elsewhere while its own rejoin - all full is the busy page - a drained host "
           "keeps its session and takes no new one",
-          "[cluster]") {
+          "[cluster][waits]") {
   ClusterUnderTest cluster({.hosts = 3, .max_sessions = 2, .rate_limit = false,
                             .config_yaml = rfbsim::test::minimal_sessions_yaml()});
   const std::string a = "h1";

@@ -44,7 +44,7 @@ std::multimap<std::string, std::string> sessions_by_uid(const ClusterUnderTest& 
 
 TEST_CASE("a killed host is marked down within 5 s and its participants see session lost - no uid gets a second "
           "session across its restart and an HAProxy reload",
-          "[cluster]") {
+          "[cluster][waits]") {
   ClusterUnderTest cluster({.hosts = 3, .max_sessions = 2, .rate_limit = false,
                             .config_yaml = rfbsim::test::minimal_sessions_yaml()});
 

@@ -14,7 +14,7 @@ using rfbsim::test::ClusterUnderTest;
 using rfbsim::test::RfbTestClient;
 using rfbsim::test::WsRfbBridge;
 
-TEST_CASE("a WebSocket through HAProxy stays up for 60 s and shows frames all along", "[cluster][long]") {
+TEST_CASE("a WebSocket through HAProxy stays up for 60 s and shows frames all along", "[cluster][long][waits]") {
   ClusterUnderTest cluster({.hosts = 3, .max_sessions = 1, .rate_limit = false,
                             .config_yaml = rfbsim::test::minimal_sessions_yaml()});
   const auto started = cluster.start("uid=ws-1");

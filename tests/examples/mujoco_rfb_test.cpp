@@ -77,7 +77,8 @@ void pump_for(RfbTestClient& client, std::chrono::milliseconds duration) {
 
 }  // namespace
 
-TEST_CASE("mujoco_rfb shows the arm, holds still without keys, W moves the arm, the pointer moves the camera") {
+TEST_CASE("mujoco_rfb shows the arm, holds still without keys, W moves the arm, the pointer moves the camera",
+          "[waits]") {
   // Any folder makes the server answer HTTP too, and its ready line an http:// URL.
   ScratchDir page("mujoco_rfb_page");
   page.write("index.html", "<!DOCTYPE html><title>mujoco_rfb test</title>\n");

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "hud_panels.hpp"
 #include "render/gl_hud.hpp"
 #include "render/gl_renderer.hpp"
 #include "render/hud.hpp"
@@ -27,6 +28,7 @@ using rfbsim::sim::HudAnchor;
 using rfbsim::sim::HudPanel;
 using rfbsim::sim::HudRasterizer;
 using rfbsim::sim::PlacedHudImage;
+using rfbsim::test::panel_of;
 
 using Pixel = std::array<int, 4>;
 
@@ -74,13 +76,6 @@ int worst_difference(const rfbsim::FrameView& frame, const std::vector<PlacedHud
     }
   }
   return worst;
-}
-
-HudPanel panel_of(std::initializer_list<std::string> texts, HudAnchor anchor) {
-  HudPanel panel;
-  for (const auto& text : texts) panel.lines.push_back({text});
-  panel.anchor = anchor;
-  return panel;
 }
 
 void clear_to_grey() {

@@ -10,6 +10,8 @@
 #include <optional>
 #include <string>
 
+#include "hud_panels.hpp"
+
 namespace {
 
 using rfbsim::sim::Hud;
@@ -18,13 +20,7 @@ using rfbsim::sim::HudImage;
 using rfbsim::sim::HudLine;
 using rfbsim::sim::HudPanel;
 using rfbsim::sim::HudRasterizer;
-
-HudPanel panel_of(std::initializer_list<std::string> texts, HudAnchor anchor = HudAnchor::TopLeft) {
-  HudPanel panel;
-  for (const auto& text : texts) panel.lines.push_back({text});
-  panel.anchor = anchor;
-  return panel;
-}
+using rfbsim::test::panel_of;
 
 std::array<int, 4> at(const HudImage& image, int x, int y) {
   const std::uint8_t* p = &image.rgba[static_cast<std::size_t>((y * image.width + x) * 4)];

@@ -10,31 +10,33 @@
 #include <thread>
 #include <vector>
 
+#include "eventually.hpp"
 #include "h264_rfb_client.hpp"
 #include "rfb_test_client.hpp"
 #include "rfbsim/server.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::eventually;
 using rfbsim::test::H264RfbClient;
 using rfbsim::test::RfbTestClient;
 
 namespace {
 
-constexpr int kWidth = 320;
-constexpr int kHeight = 240;
+constexpr int kH264Width = 320;
+constexpr int kH264Height = 240;
 
 // A smooth picture that depends on `k`: a diagonal gradient and, over a quarter of it, a block whose colour
 // swings between two far-apart colours from one k to the next, so that consecutive pictures differ by far
 // more (a mean of about 45 per channel) than the encoder's error on a smooth picture (under 1).
 std::vector<std::uint8_t> picture(int k) {
-  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(kWidth) * kHeight * 4U);
+  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(kH264Width) * kH264Height * 4U);
   const bool warm = k % 2 == 0;
-  for (int y = 0; y < kHeight; ++y) {
-    for (int x = 0; x < kWidth; ++x) {
-      std::uint8_t* p = &pixels[(static_cast<std::size_t>(y) * kWidth + static_cast<std::size_t>(x)) * 4U];
+  for (int y = 0; y < kH264Height; ++y) {
+    for (int x = 0; x < kH264Width; ++x) {
+      std::uint8_t* p = &pixels[(static_cast<std::size_t>(y) * kH264Width + static_cast<std::size_t>(x)) * 4U];
       const bool block = x >= 40 + k * 8 && x < 200 + k * 8 && y >= 60 && y < 180;
-      p[0] = block ? (warm ? 250 : 20) : static_cast<std::uint8_t>(x * 255 / kWidth);
-      p[1] = block ? (warm ? 230 : 60) : static_cast<std::uint8_t>(y * 255 / kHeight);
+      p[0] = block ? (warm ? 250 : 20) : static_cast<std::uint8_t>(x * 255 / kH264Width);
+      p[1] = block ? (warm ? 230 : 60) : static_cast<std::uint8_t>(y * 255 / kH264Height);
       p[2] = block ? (warm ? 30 : 230) : static_cast<std::uint8_t>(128 + (x + y) / 8);
       p[3] = 255;
     }
@@ -44,23 +46,14 @@ std::vector<std::uint8_t> picture(int k) {
 
 rfbsim::ServerOptions h264_server(rfbsim::Codec codec = rfbsim::Codec::kH264) {
   rfbsim::ServerOptions options;
-  options.width = kWidth;
-  options.height = kHeight;
+  options.width = kH264Width;
+  options.height = kH264Height;
   options.codec = codec;
   return options;
 }
 
 void submit(rfbsim::Server& server, const std::vector<std::uint8_t>& pixels) {
-  server.submit(rfbsim::FrameView{pixels.data(), kWidth, kHeight, 0});
-}
-
-bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() >= deadline) return condition();
-    std::this_thread::sleep_for(10ms);
-  }
-  return true;
+  server.submit(rfbsim::FrameView{pixels.data(), kH264Width, kH264Height, 0});
 }
 
 std::string encoding_of(const rfbsim::Server& server, int id) {
@@ -85,7 +78,7 @@ TEST_CASE("an H.264 client gets pictures that decode to the served frames", "[st
   for (int k = 0; k < 8; ++k) {
     const auto pixels = picture(k);
     submit(server, pixels);
-    const rfbsim::FrameView served{pixels.data(), kWidth, kHeight, 0};
+    const rfbsim::FrameView served{pixels.data(), kH264Width, kH264Height, 0};
     // Smooth content at CRF 23: the decoded picture is within a few levels of the source everywhere.
     INFO("frame " << k);
     CHECK(client.pump_until([&] { return rfbsim::test::mean_abs_difference(client.frame(), served) < 3.0; }, 10s));
@@ -127,7 +120,7 @@ TEST_CASE("with codec h264, clients that do not offer it get Tight beside an H.2
   for (int k = 0; k < 3; ++k) {
     const auto pixels = picture(k);
     submit(server, pixels);
-    const rfbsim::FrameView served{pixels.data(), kWidth, kHeight, 0};
+    const rfbsim::FrameView served{pixels.data(), kH264Width, kH264Height, 0};
     CHECK(h264.pump_until([&] { return rfbsim::test::mean_abs_difference(h264.frame(), served) < 3.0; }, 10s));
     CHECK(tight.pump_until([&] { return rfbsim::test::mean_abs_difference(tight.frame(), served) < 3.0; }, 10s));
   }

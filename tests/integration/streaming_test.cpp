@@ -13,11 +13,13 @@
 #include <thread>
 #include <vector>
 
+#include "eventually.hpp"
 #include "link_emulator.hpp"
 #include "rfb_test_client.hpp"
 #include "rfbsim/server.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::eventually;
 using rfbsim::test::RfbTestClient;
 using rfbsim::test::UpdateMode;
 
@@ -69,7 +71,7 @@ class FrameSource {
   std::thread thread_;
 };
 
-rfbsim::ServerOptions small_server() {
+rfbsim::ServerOptions streaming_server() {
   rfbsim::ServerOptions options;
   options.width = kWidth;
   options.height = kHeight;
@@ -84,19 +86,10 @@ std::optional<rfbsim::ClientStreamStatus> stream_of(const rfbsim::Server& server
   return std::nullopt;
 }
 
-bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() >= deadline) return condition();
-    std::this_thread::sleep_for(10ms);
-  }
-  return true;
-}
-
 }  // namespace
 
 TEST_CASE("a ContinuousUpdates client gets frames pushed while it sends no update request", "[streaming]") {
-  rfbsim::Server server(small_server());
+  rfbsim::Server server(streaming_server());
   FrameSource frames(server);
   RfbTestClient client("127.0.0.1", server.port(), 8, UpdateMode::kContinuous);
   REQUIRE(client.pump_until([&] { return client.continuous(); }, 10s));
@@ -119,7 +112,7 @@ TEST_CASE("a ContinuousUpdates client gets frames pushed while it sends no updat
 }
 
 TEST_CASE("a requesting client and a ContinuousUpdates client are served side by side", "[streaming]") {
-  rfbsim::Server server(small_server());
+  rfbsim::Server server(streaming_server());
   FrameSource frames(server);
   RfbTestClient plain("127.0.0.1", server.port());
   RfbTestClient pushed("127.0.0.1", server.port(), 8, UpdateMode::kContinuous);
@@ -136,7 +129,7 @@ TEST_CASE("a requesting client and a ContinuousUpdates client are served side by
 }
 
 TEST_CASE("disabling ContinuousUpdates goes back to requested updates", "[streaming]") {
-  rfbsim::Server server(small_server());
+  rfbsim::Server server(streaming_server());
   FrameSource frames(server);
   RfbTestClient client("127.0.0.1", server.port(), 8, UpdateMode::kContinuous);
   REQUIRE(client.pump_until([&] { return client.continuous(); }, 10s));
@@ -149,8 +142,8 @@ TEST_CASE("disabling ContinuousUpdates goes back to requested updates", "[stream
   REQUIRE(eventually([&] { return stream_of(server, 1) && !stream_of(server, 1)->continuous_updates; }, 5s));
 }
 
-TEST_CASE("over a slow link frames are held back and coalesce, and the newest picture arrives", "[streaming]") {
-  rfbsim::Server server(small_server());
+TEST_CASE("over a slow link frames are held back and coalesce, and the newest picture arrives", "[streaming][waits]") {
+  rfbsim::Server server(streaming_server());
   // 200 ms round trip and 2 Mbit/s: a 320x240 noise frame (~100 KB as JPEG) takes ~0.4 s to cross, so
   // most of the 30 frames a second must be held back and merged into the next update.
   rfbsim::test::LinkEmulator link("127.0.0.1", server.port(), rfbsim::test::link_profile(200ms, 2.0));

@@ -15,6 +15,7 @@
 #include "record/session_writer.hpp"
 #include "file_text.hpp"
 #include "scratch_dir.hpp"
+#include "skip.hpp"
 #include "small_tmpfs.hpp"
 
 using namespace rfbsim::sim;
@@ -133,10 +134,7 @@ TEST_CASE("a real full disk (a 64 KiB tmpfs) stops the recording with the kernel
   const auto mount_point = scratch.path() / "mnt";
   std::filesystem::create_directories(mount_point);
   SmallTmpfs tmpfs(mount_point, 64 * 1024);
-  if (!tmpfs.mounted()) {
-    WARN("SKIPPED: " << tmpfs.why_not() << "; the injected fault covers the same path");
-    return;
-  }
+  if (!tmpfs.mounted()) RFBSIM_SKIP(tmpfs.why_not());
   const auto dir = mount_point / "session";
   World world = one_person_world();
   SessionWriter writer(dir, info(), world);

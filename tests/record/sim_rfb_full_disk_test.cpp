@@ -16,19 +16,16 @@
 #include "rfb_test_client.hpp"
 #include "scratch_dir.hpp"
 #include "sim_process.hpp"
+#include "skip.hpp"
 #include "small_tmpfs.hpp"
+#include "status_tick.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::current_tick;
 using rfbsim::test::PipedSim;
 using rfbsim::test::ScratchDir;
 
 namespace {
-
-std::uint64_t current_tick(int port) {
-  const auto response = rfbsim::test::net::http_get(port, "/status.json");
-  REQUIRE(response.status == 200);
-  return nlohmann::json::parse(response.body)["tick"].get<std::uint64_t>();
-}
 
 // Runs the lab scenario into `dir` until the pipe says the data is incomplete, checks that the session goes
 // on (its clock advances and a viewer gets frames), ends it with SIGTERM, and returns the line's reason.
@@ -82,15 +79,12 @@ TEST_CASE("sim_rfb whose data writes fail tells its parent once, keeps the sessi
   CHECK_FALSE(std::filesystem::exists(dir / "session.json.reserve"));
 }
 
-TEST_CASE("sim_rfb recording onto a real full disk (a 32 KiB tmpfs) tells its parent and notes why") {
+TEST_CASE("sim_rfb recording onto a real full disk (a 32 KiB tmpfs) tells its parent and notes why", "[waits]") {
   ScratchDir scratch;
   const auto mount_point = scratch.path() / "mnt";
   std::filesystem::create_directories(mount_point);
   rfbsim::test::SmallTmpfs tmpfs(mount_point, 32 * 1024);
-  if (!tmpfs.mounted()) {
-    WARN("SKIPPED: " << tmpfs.why_not() << "; the write-failure seam covers the same path");
-    return;
-  }
+  if (!tmpfs.mounted()) RFBSIM_SKIP(tmpfs.why_not());
   const auto dir = mount_point / "session";
   const std::string reason = run_until_incomplete(dir, {}, scratch.path() / "sim.log");
   CHECK_THAT(reason, Catch::Contains("No space left on device"));

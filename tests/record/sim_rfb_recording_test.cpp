@@ -16,9 +16,11 @@
 #include "record/session_log.hpp"
 #include "rfb_test_client.hpp"
 #include "sim_process.hpp"
+#include "status_tick.hpp"
 #include "scratch_dir.hpp"
 
 using nlohmann::json;
+using rfbsim::test::current_tick;
 using rfbsim::test::ScratchDir;
 using rfbsim::test::SimProcess;
 
@@ -40,12 +42,6 @@ std::vector<std::string> complete_lines(const std::filesystem::path& file) {
 }
 
 // The simulation's tick now, from /status.json.
-std::uint64_t current_tick(int port) {
-  const auto response = rfbsim::test::net::http_get(port, "/status.json");
-  REQUIRE(response.status == 200);
-  return json::parse(response.body)["tick"].get<std::uint64_t>();
-}
-
 }  // namespace
 
 TEST_CASE("sim_rfb killed with SIGKILL leaves readable session files up to two seconds before the kill") {

@@ -9,15 +9,15 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "file_text.hpp"
 #include "record/session_log.hpp"
 #include "replay_fixtures.hpp"
 
 using namespace rfbsim;
+using rfbsim::test::contains;
 using nlohmann::json;
 
 namespace {
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 json read_json(const std::filesystem::path& file) {
   std::ifstream in(file);

@@ -25,6 +25,7 @@
 #include "replay_fixtures.hpp"
 #include "rfb_test_client.hpp"
 #include "sim_process.hpp"
+#include "skip.hpp"
 
 using namespace rfbsim;
 
@@ -192,11 +193,8 @@ std::vector<Pixels> decoded_frames(const std::filesystem::path& video, const std
 
 }  // namespace
 
-TEST_CASE("the replay's video shows the frames sim_rfb served at the same ticks within H.264's loss") {
-  if (std::string(RFBSIM_FFMPEG).empty()) {
-    WARN("ffmpeg not found (Debian package ffmpeg; scripts/setup.sh installs it): frame comparison skipped");
-    return;
-  }
+TEST_CASE("the replay's video shows the frames sim_rfb served at the same ticks within H.264's loss", "[waits]") {
+  if (std::string(RFBSIM_FFMPEG).empty()) RFBSIM_SKIP("ffmpeg not found at configure time (apt-get install ffmpeg)");
   const auto dir = test::fresh_dir("served_frames");
   std::vector<Still> stills;
   {

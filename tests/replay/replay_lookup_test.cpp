@@ -7,22 +7,18 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "file_text.hpp"
 #include "replay_cli.hpp"
 #include "replay_fixtures.hpp"
 #include "session_lookup.hpp"
 
 using namespace rfbsim;
+using rfbsim::test::contains;
+using rfbsim::test::write_text;
 using namespace rfbsim::replay;
 using nlohmann::json;
 
 namespace {
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
-
-void write_text(const std::filesystem::path& file, const std::string& text) {
-  std::filesystem::create_directories(file.parent_path());
-  std::ofstream(file, std::ios::trunc) << text;
-}
 
 // A folder that the catalog takes for a session: a session.json of `uid`, and a manager.json naming `host`.
 void fake_session(const std::filesystem::path& dir, const std::string& uid, const std::optional<std::string>& host) {

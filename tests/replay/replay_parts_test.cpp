@@ -9,6 +9,7 @@
 #include <fstream>
 #include <numbers>
 
+#include "file_text.hpp"
 #include "progress_line.hpp"
 #include "provenance.hpp"
 #include "render/scene_builder.hpp"
@@ -16,6 +17,7 @@
 #include "trajectory_diff.hpp"
 
 using namespace rfbsim;
+using rfbsim::test::write_text;
 using namespace rfbsim::replay;
 
 namespace {
@@ -25,8 +27,6 @@ std::filesystem::path scratch(const std::string& name) {
   std::filesystem::create_directories(dir);
   return dir / name;
 }
-
-void write_text(const std::filesystem::path& file, const std::string& text) { std::ofstream(file, std::ios::trunc) << text; }
 
 constexpr const char* kHeader = "tick,time,kind,id,x,y,yaw,vx,vy\n";
 constexpr const char* kRow0 = "0,0.000000,avatar,0,1.000000,2.000000,0.000000,0.000000,0.000000\n";

@@ -11,15 +11,16 @@
 #include <sstream>
 #include <nlohmann/json.hpp>
 
+#include "file_text.hpp"
 #include "replay_fixtures.hpp"
 #include "sim_process.hpp"
+#include "skip.hpp"
 
 using namespace rfbsim;
+using rfbsim::test::contains;
 using nlohmann::json;
 
 namespace {
-
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // The lab at 320x240, a viewer from the start, walking and turning, ended by a signal at tick 300.
 test::Recording record_small_lab(const std::filesystem::path& dir) {
@@ -81,18 +82,12 @@ double spread(const std::string& bytes) {
   return sum / static_cast<double>(bytes.size());
 }
 
-bool have_ffmpeg() {
-  if (std::string(RFBSIM_FFPROBE).empty() || std::string(RFBSIM_FFMPEG).empty()) {
-    WARN("ffprobe or ffmpeg not found (Debian package ffmpeg; scripts/setup.sh installs it): video checks skipped");
-    return false;
-  }
-  return true;
-}
+bool have_ffmpeg() { return !std::string(RFBSIM_FFPROBE).empty() && !std::string(RFBSIM_FFMPEG).empty(); }
 
 }  // namespace
 
 TEST_CASE("the video is H.264 at the recorded size and rate with one frame per two ticks, in both views") {
-  if (!have_ffmpeg()) return;
+  if (!have_ffmpeg()) RFBSIM_SKIP("ffprobe or ffmpeg not found at configure time (apt-get install ffmpeg)");
   const auto dir = test::fresh_dir("video");
   const test::Recording recording = record_small_lab(dir);
   REQUIRE(recording.end_tick == 300);

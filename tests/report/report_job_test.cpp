@@ -36,13 +36,6 @@ SessionSpec line_session(const std::string& uid, const std::string& scenario, do
   return spec;
 }
 
-const std::map<std::string, std::string>& row_of(const std::vector<std::map<std::string, std::string>>& rows,
-                                                 const std::string& uid) {
-  const auto it = std::find_if(rows.begin(), rows.end(), [&](const auto& r) { return r.at("uid") == uid; });
-  REQUIRE(it != rows.end());
-  return *it;
-}
-
 double number(const std::map<std::string, std::string>& row, const std::string& column) {
   return std::stod(row.at(column));
 }

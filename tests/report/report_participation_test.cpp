@@ -28,13 +28,6 @@ SessionSpec session_of(const std::string& uid, const std::string& scenario, bool
   return spec;
 }
 
-const std::map<std::string, std::string>& row_of(const std::vector<std::map<std::string, std::string>>& rows,
-                                                 const std::string& uid) {
-  const auto it = std::find_if(rows.begin(), rows.end(), [&](const auto& r) { return r.at("uid") == uid; });
-  REQUIRE(it != rows.end());
-  return *it;
-}
-
 }  // namespace
 
 TEST_CASE("abandoned sessions are shown but left out of the statistics, and each session says if its link was spent") {

@@ -6,11 +6,13 @@
 
 #include <stdlib.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -19,24 +21,20 @@
 
 #include <nlohmann/json.hpp>
 
+#include "file_text.hpp"
 #include "scratch_dir.hpp"
 
 namespace rfbsim::report::test {
 
 using rfbsim::test::ScratchDir;  // tests/support: a fresh folder per test, removed at scope exit
 
-inline void write_text(const std::filesystem::path& file, const std::string& text) {
-  std::filesystem::create_directories(file.parent_path());
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out << text;
-}
+using rfbsim::test::write_text;  // tests/support/file_text.hpp
 
-inline std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+/// The whole content of `file` ("" when it cannot be read).
+inline std::string read_text(const std::filesystem::path& file) { return rfbsim::test::file_text(file); }
+
+/// Pi, for the hand-made tracks' angles.
+inline constexpr double kPi = std::numbers::pi;
 
 /// Where an agent is at simulated time t: position (m), yaw (rad), velocity (m/s).
 struct State {
@@ -218,6 +216,14 @@ inline std::vector<std::map<std::string, std::string>> csv_records(const std::st
     out.push_back(record);
   }
   return out;
+}
+
+/// The record of `rows` (csv_records) whose uid column is `uid`; throws when there is none.
+inline const std::map<std::string, std::string>& row_of(const std::vector<std::map<std::string, std::string>>& rows,
+                                                        const std::string& uid) {
+  const auto it = std::find_if(rows.begin(), rows.end(), [&](const auto& r) { return r.at("uid") == uid; });
+  if (it == rows.end()) throw std::runtime_error("no row for uid '" + uid + "'");
+  return *it;
 }
 
 }  // namespace rfbsim::report::test

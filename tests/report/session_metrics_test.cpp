@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "measured_session.hpp"
 #include "record/session_log.hpp"
 #include "session_files.hpp"
 #include "session_metrics.hpp"
@@ -16,8 +17,6 @@ using namespace rfbsim::report;
 using namespace rfbsim::report::test;
 
 namespace {
-
-constexpr double kPi = std::numbers::pi;
 
 // The robot stands still for 2 s turning in place from pi/2 to 0, then drives +x at 0.5 m/s for 10 s:
 // from (0, 0) to (5, 0). The avatar stands 1 m to the side of the line's middle, at (2.5, 1); one person
@@ -46,12 +45,6 @@ SessionSpec passing_session() {
       event(700, "robot", {{"state", "arrived"}, {"detail", "again"}}),
   };
   return spec;
-}
-
-SessionMetrics measure(const ScratchDir& scratch, const SessionSpec& spec) {
-  write_session(scratch.path(), spec);
-  const auto log = rfbsim::sim::read_session(scratch.path());
-  return session_metrics(log, assemble_samples(log));
 }
 
 }  // namespace

@@ -6,11 +6,13 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 #include <stdexcept>
 #include <string>
 
 #include "group_summary.hpp"
+#include "measured_session.hpp"
 #include "record/session_log.hpp"
 #include "report_columns.hpp"
 #include "report_job.hpp"
@@ -24,7 +26,6 @@ using namespace rfbsim::report::test;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kTouch = 0.16 + 0.25;  // m: robot and body radii summed
 
 // The robot starts at rest at (0, 0) facing +x, drives at 0.5 m/s straight at the participant's avatar
@@ -61,12 +62,6 @@ SessionSpec passers_by_session() {
   return spec;
 }
 
-SessionMetrics measure(const ScratchDir& scratch, const SessionSpec& spec) {
-  write_session(scratch.path(), spec);
-  const auto log = rfbsim::sim::read_session(scratch.path());
-  return session_metrics(log, assemble_samples(log));
-}
-
 std::string cell(const SessionMetrics& m, const std::string& column) {
   return csv_cell(session_column(column).value(m));
 }
@@ -83,6 +78,12 @@ const char* const kSocialColumns[] = {
     "robot_caused_personal_intrusions", "robot_intimate_intrusions",     "robot_caused_intimate_intrusions",
     "robot_intrusion_share",            "robot_min_ttc_moving_toward",   "robot_path_irregularity_per_m",
     "robot_time_stopped"};
+
+// The approach and passers-by sessions, as data/1-approach and data/2-passers.
+void write_robot_social_sessions(const std::filesystem::path& data) {
+  write_session(data / "1-approach", approach_session());
+  write_session(data / "2-passers", passers_by_session());
+}
 
 const Rate& rate(const std::string& name) {
   for (const Rate& r : summary_rates()) {
@@ -225,11 +226,36 @@ TEST_CASE("a time column that runs backwards is refused with the tick, and the r
   CHECK_THAT(result.skipped[0].reason, Catch::Contains("trajectories.csv") && Catch::Contains("tick 12"));
 }
 
-TEST_CASE("sessions.csv and summary.csv carry the social measures; sessions without a robot add no zeros") {
+TEST_CASE("sessions.csv and summary.csv carry the social measures") {
   ScratchDir scratch;
   const auto data = scratch.path() / "data";
-  write_session(data / "1-approach", approach_session());
-  write_session(data / "2-passers", passers_by_session());
+  write_robot_social_sessions(data);
+  const auto out = scratch.path() / "out";
+  REQUIRE(run_report(data, out).exit_status() == 0);
+
+  const auto rows = csv_records(read_text(out / "sessions.csv"));
+  REQUIRE(rows.size() == 2);
+  CHECK(rows[0].at("robot_caused_personal_intrusions") == "1");
+  CHECK(std::stod(rows[0].at("robot_min_distance_moving_toward")) == Approx(1.0));
+  CHECK(rows[1].at("robot_caused_personal_intrusions") == "0");
+  CHECK(rows[1].at("robot_min_distance_moving_toward").empty());
+
+  // The group's statistics are over the sessions with a value.
+  const auto groups = csv_records(read_text(out / "summary.csv"));
+  REQUIRE_FALSE(groups.empty());
+  const auto& all = groups[0];
+  CHECK(all.at("robot_caused_personal_intrusions_n") == "2");
+  CHECK(std::stod(all.at("robot_caused_personal_intrusions_mean")) == Approx(0.5));
+  CHECK(all.at("robot_min_distance_moving_toward_n") == "1");
+  CHECK(std::stod(all.at("robot_min_distance_moving_toward_median")) == Approx(1.0));
+  CHECK(std::stod(all.at("robot_intrusion_share_mean")) == Approx(50.0));
+  CHECK(std::stod(all.at("pct_robot_caused_intimate")) == Approx(0.0));
+}
+
+TEST_CASE("sessions without a robot add no zeros to sessions.csv or summary.csv") {
+  ScratchDir scratch;
+  const auto data = scratch.path() / "data";
+  write_robot_social_sessions(data);
   SessionSpec alone;
   alone.uid = "alone";
   alone.samples = 11;
@@ -240,10 +266,6 @@ TEST_CASE("sessions.csv and summary.csv carry the social measures; sessions with
 
   const auto rows = csv_records(read_text(out / "sessions.csv"));
   REQUIRE(rows.size() == 3);
-  CHECK(rows[0].at("robot_caused_personal_intrusions") == "1");
-  CHECK(std::stod(rows[0].at("robot_min_distance_moving_toward")) == Approx(1.0));
-  CHECK(rows[1].at("robot_caused_personal_intrusions") == "0");
-  CHECK(rows[1].at("robot_min_distance_moving_toward").empty());
   for (const char* column : kSocialColumns) {
     INFO(column);
     CHECK(rows[2].at(column).empty());

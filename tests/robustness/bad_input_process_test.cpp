@@ -9,6 +9,7 @@
 #include <csignal>
 #include <thread>
 
+#include "eventually.hpp"
 #include "misbehaving_clients.hpp"
 #include "rfb_test_client.hpp"
 #include "sim_process.hpp"
@@ -16,19 +17,9 @@
 namespace {
 
 using namespace std::chrono_literals;
+using rfbsim::test::eventually;
 using rfbsim::test::RawSocket;
 using rfbsim::test::RfbTestClient;
-
-// Polls `condition` every 20 ms until it holds or `timeout` passes.
-template <typename Condition>
-bool eventually(Condition condition, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (!condition()) {
-    if (std::chrono::steady_clock::now() >= deadline) return condition();
-    std::this_thread::sleep_for(20ms);
-  }
-  return true;
-}
 
 // The "clients" field of /status.json (NaN when the document does not answer).
 double status_clients(int port) {

@@ -26,7 +26,7 @@ using rfbsim::test::eventually;
 using rfbsim::test::RawSocket;
 using rfbsim::test::ServedScene;
 
-rfbsim::ServerOptions small_server() {
+rfbsim::ServerOptions bad_input_server() {
   rfbsim::ServerOptions options;
   options.width = 160;
   options.height = 120;
@@ -67,7 +67,7 @@ TEST_CASE("garbage instead of the RFB version closes only that connection", "[ro
       {"'RFB ' then junk", "RFB 999.999\n" + rfbsim::test::random_bytes(64, 17)},
   };
   // One server for all the cases (each check below runs after every bad client).
-  ServedScene scene(small_server());
+  ServedScene scene(bad_input_server());
   for (const auto& garbage : cases) {
     // Sent at once, libvncserver's first-bytes check sees it; sent after the greeting, its version parser.
     for (const bool after_greeting : {false, true}) {
@@ -89,7 +89,7 @@ TEST_CASE("garbage instead of the RFB version closes only that connection", "[ro
 }
 
 TEST_CASE("a truncated RFB handshake is forgotten", "[robustness][rfb]") {
-  rfbsim::ServerOptions options = small_server();
+  rfbsim::ServerOptions options = bad_input_server();
   options.read_timeout = 1000ms;  // bounds how long a half-sent message may keep the server waiting
   ServedScene scene(options);
   SECTION("half a version at once, then close") {
@@ -129,7 +129,7 @@ TEST_CASE("a truncated RFB handshake is forgotten", "[robustness][rfb]") {
 }
 
 TEST_CASE("an oversized ClientCutText after a hand-made handshake closes only that client", "[robustness][rfb]") {
-  ServedScene scene(small_server());
+  ServedScene scene(bad_input_server());
   RawSocket socket(scene.port());
   const auto init = rfbsim::test::raw_rfb_handshake(socket);
   REQUIRE(init.width == 160);
@@ -151,7 +151,7 @@ TEST_CASE("an oversized ClientCutText after a hand-made handshake closes only th
 }
 
 TEST_CASE("bad WebSocket frames close only that connection", "[robustness][websocket]") {
-  rfbsim::ServerOptions options = small_server();
+  rfbsim::ServerOptions options = bad_input_server();
   options.read_timeout = 1000ms;
   ServedScene scene(options);
   RawSocket socket(scene.port());
@@ -203,7 +203,7 @@ TEST_CASE("bad WebSocket frames close only that connection", "[robustness][webso
 }
 
 TEST_CASE("a WebSocket upgrade without Origin is refused", "[robustness][websocket]") {
-  ServedScene scene(small_server());
+  ServedScene scene(bad_input_server());
   RawSocket socket(scene.port());
   std::string request = rfbsim::test::ws_upgrade_request(scene.port(), "/websockify");
   const auto origin = request.find("Origin: ");
@@ -229,7 +229,7 @@ TEST_CASE("a client that vanishes mid-update (reset) is dropped", "[robustness][
   scene.check_still_serving();
 }
 
-TEST_CASE("a client that stops reading is dropped and does not starve the others", "[robustness][rfb]") {
+TEST_CASE("a client that stops reading is dropped and does not starve the others", "[robustness][rfb][busy]") {
   rfbsim::ServerOptions options;
   options.width = 640;
   options.height = 480;
@@ -260,12 +260,12 @@ TEST_CASE("a client that stops reading is dropped and does not starve the others
   scene.check_still_serving();
 }
 
-TEST_CASE("malformed HTTP gets the right status and leaves RFB alone", "[robustness][http]") {
+TEST_CASE("malformed HTTP gets the right status and leaves RFB alone", "[robustness][http][busy]") {
   // A web root, so that path checks (403) are reached.
   const auto root = std::filesystem::temp_directory_path() / ("rfbsim_robustness_" + std::to_string(::getpid()));
   std::filesystem::create_directories(root);
   std::ofstream(root / "index.html") << "<!doctype html><title>t</title>\n";
-  rfbsim::ServerOptions options = small_server();
+  rfbsim::ServerOptions options = bad_input_server();
   options.web_root = root.string();
   options.json_routes["/status.json"] = [] { return std::string(R"({"ok":1})"); };
   {
@@ -315,8 +315,8 @@ TEST_CASE("malformed HTTP gets the right status and leaves RFB alone", "[robustn
   std::filesystem::remove_all(root);
 }
 
-TEST_CASE("HTTP connections beyond the worker pool wait for a worker instead of failing", "[robustness][http]") {
-  rfbsim::ServerOptions options = small_server();
+TEST_CASE("HTTP connections beyond the worker pool wait for a worker instead of failing", "[robustness][http][waits]") {
+  rfbsim::ServerOptions options = bad_input_server();
   options.json_routes["/status.json"] = [] { return std::string(R"({"ok":1})"); };
   ServedScene scene(options);
   const int port = scene.port();

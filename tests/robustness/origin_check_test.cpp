@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "raw_socket.hpp"
 #include "rfbsim/server.hpp"
@@ -18,7 +19,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-rfbsim::ServerOptions small_server(bool with_http) {
+rfbsim::ServerOptions origin_server(bool with_http) {
   rfbsim::ServerOptions options;
   options.width = 64;
   options.height = 48;
@@ -47,6 +48,12 @@ std::string answer_to(int port, const std::string& host, const std::optional<std
   return answer_to(socket, upgrade_request(host, origin));
 }
 
+// A grey 64x48 picture for the clients of an origin_server.
+void submit_origin_grey_frame(rfbsim::Server& server) {
+  const std::vector<std::uint8_t> grey(64U * 48U * 4U, 128);
+  server.submit(rfbsim::FrameView{grey.data(), 64, 48, 0});
+}
+
 constexpr const char* kSwitching = "HTTP/1.1 101 Switching Protocols";
 constexpr const char* kForbidden = "HTTP/1.1 403 Forbidden";
 
@@ -55,7 +62,7 @@ constexpr const char* kForbidden = "HTTP/1.1 403 Forbidden";
 TEST_CASE("a page from another origin is refused a WebSocket: 403, closed, no client", "[robustness][origin]") {
   for (const bool with_http : {true, false}) {
     INFO("with HTTP: " << with_http);
-    rfbsim::Server server(small_server(with_http));
+    rfbsim::Server server(origin_server(with_http));
     const std::string host = "127.0.0.1:" + std::to_string(server.port());
     for (const char* origin : {"https://evil.example", "http://evil.example:" /* no port digits */, "null",
                                "http://127.0.0.2:80", "http://localhost.evil.example"}) {
@@ -74,7 +81,7 @@ TEST_CASE("the server's own page, loopback pages and clients without Origin get 
           "[robustness][origin]") {
   for (const bool with_http : {true, false}) {
     INFO("with HTTP: " << with_http);
-    rfbsim::Server server(small_server(with_http));
+    rfbsim::Server server(origin_server(with_http));
     const int port = server.port();
     const std::string p = std::to_string(port);
     // Same origin: the page came from the Host the upgrade names (a lab machine's name, or a TLS front end).
@@ -98,7 +105,7 @@ TEST_CASE("the server's own page, loopback pages and clients without Origin get 
 }
 
 TEST_CASE("allowed_origins lets listed pages in, exactly, and '*' lets every page in", "[robustness][origin]") {
-  rfbsim::ServerOptions options = small_server(true);
+  rfbsim::ServerOptions options = origin_server(true);
   options.allowed_origins = {"https://Study.Example.org", "http://pilot.example:8080"};
   rfbsim::Server server(options);
   const int port = server.port();
@@ -119,30 +126,32 @@ TEST_CASE("allowed_origins lets listed pages in, exactly, and '*' lets every pag
 TEST_CASE("a malformed allowed origin is refused when the server starts, naming it", "[robustness][origin]") {
   for (const char* bad : {"study.example.org", "https://study.example.org/", "ftp://x.example", "https://a b",
                           "https://x.example:99999", ""}) {
-    rfbsim::ServerOptions options = small_server(false);
+    rfbsim::ServerOptions options = origin_server(false);
     options.allowed_origins = {bad};
     CHECK_THROWS_WITH(rfbsim::Server(options), Catch::Contains("allowed origin '" + std::string(bad) + "'"));
   }
 }
 
-TEST_CASE("a real WebSocket client from a loopback page is served; one from another page is refused",
-          "[robustness][origin]") {
-  rfbsim::Server server(small_server(true));
-  const std::vector<std::uint8_t> grey(64U * 48U * 4U, 128);
-  server.submit(rfbsim::FrameView{grey.data(), 64, 48, 0});
-  {
-    rfbsim::test::WsTestClient ws(server.port(), "/websockify", "http://localhost:6080", "binary");
-    std::vector<std::uint8_t> version;
-    REQUIRE(ws.read_exact(12, version, 5s));
-    CHECK(std::string(version.begin(), version.end()) == "RFB 003.008\n");
-  }
+TEST_CASE("a real WebSocket client from a loopback page is served", "[robustness][origin]") {
+  rfbsim::Server server(origin_server(true));
+  submit_origin_grey_frame(server);
+  rfbsim::test::WsTestClient ws(server.port(), "/websockify", "http://localhost:6080", "binary");
+  std::vector<std::uint8_t> version;
+  REQUIRE(ws.read_exact(12, version, 5s));
+  CHECK(std::string(version.begin(), version.end()) == "RFB 003.008\n");
+}
+
+TEST_CASE("a real WebSocket client from another page is refused", "[robustness][origin]") {
+  rfbsim::Server server(origin_server(true));
+  submit_origin_grey_frame(server);
   CHECK_THROWS(rfbsim::test::WsTestClient(server.port(), "/websockify", "https://evil.example", "binary"));
+  CHECK(server.client_count() == 0);
 }
 
 TEST_CASE("behind a relay (PROXY lines) the server does not check origins: the relay does",
           "[robustness][origin]") {
   for (const bool with_http : {true, false}) {
-    rfbsim::ServerOptions options = small_server(with_http);
+    rfbsim::ServerOptions options = origin_server(with_http);
     options.proxy_protocol = true;
     rfbsim::Server server(options);
     RawSocket socket(server.port());
@@ -159,7 +168,7 @@ TEST_CASE("a WebSocket head that comes after the intake stopped waiting never be
   // or the other: taken for a bad RFB version, or handshaken by libvncserver and then refused by the
   // new-client hook because its Origin was never checked. Either way no client ever exists.
   std::atomic<int> connects{0};
-  rfbsim::ServerOptions options = small_server(false);
+  rfbsim::ServerOptions options = origin_server(false);
   options.on_connect = [&connects](const rfbsim::ClientInfo&) { ++connects; };
   rfbsim::Server server(options);
   for (const auto delay : {110ms, 150ms, 190ms}) {

@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "eventually.hpp"
 #include "rfb_test_client.hpp"
 #include "rfbsim/server.hpp"
 
@@ -24,17 +25,6 @@ using Clock = std::chrono::steady_clock;
 
 // How long the checks wait for an effect to show; generous, never a timing assertion.
 inline constexpr std::chrono::milliseconds kPatience{10000};
-
-// Polls `condition` every 10 ms until it holds or `timeout` passes.
-template <typename Condition>
-inline bool eventually(Condition condition, std::chrono::milliseconds timeout) {
-  const auto deadline = Clock::now() + timeout;
-  while (!condition()) {
-    if (Clock::now() >= deadline) return condition();
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return true;
-}
 
 struct Rgb {
   std::uint8_t r, g, b;

@@ -20,7 +20,7 @@ using rfbsim::test::ServedScene;
 
 }  // namespace
 
-TEST_CASE("a client dribbling one message byte by byte does not starve the others", "[robustness][slow]") {
+TEST_CASE("a client dribbling one message byte by byte does not starve the others", "[robustness][slow][busy]") {
   rfbsim::ServerOptions options;
   options.width = 160;
   options.height = 120;

@@ -24,7 +24,7 @@ constexpr std::int32_t kRaw = 0;
 constexpr std::int32_t kFence = -312;
 constexpr std::int32_t kContinuousUpdates = -313;
 
-rfbsim::ServerOptions small_server() {
+rfbsim::ServerOptions edges_server() {
   rfbsim::ServerOptions options;
   options.width = 160;
   options.height = 120;
@@ -92,7 +92,7 @@ bool still_answers_requests(RawSocket& socket, const rfbsim::test::RfbServerInit
 }  // namespace
 
 TEST_CASE("EnableContinuousUpdates without Fence closes only that client", "[robustness][streaming]") {
-  ServedScene scene(small_server());
+  ServedScene scene(edges_server());
   RawSocket socket(scene.port());
   const auto init = rfbsim::test::raw_rfb_handshake(socket);
   SECTION("ContinuousUpdates listed, Fence not") {
@@ -107,7 +107,7 @@ TEST_CASE("EnableContinuousUpdates without Fence closes only that client", "[rob
 
 TEST_CASE("EnableContinuousUpdates for an area outside the framebuffer closes only that client",
           "[robustness][streaming]") {
-  ServedScene scene(small_server());
+  ServedScene scene(edges_server());
   RawSocket socket(scene.port());
   const auto init = negotiate_streaming(socket);
   REQUIRE(socket.send_all(enable_continuous(true, 10, 0, init.width, init.height)));
@@ -117,7 +117,7 @@ TEST_CASE("EnableContinuousUpdates for an area outside the framebuffer closes on
 }
 
 TEST_CASE("a fence payload over 64 bytes closes only that client", "[robustness][streaming]") {
-  ServedScene scene(small_server());
+  ServedScene scene(edges_server());
   RawSocket socket(scene.port());
   negotiate_streaming(socket);
   REQUIRE(socket.send_all(fence(1U << 31, std::vector<std::uint8_t>(65, 'x'))));
@@ -127,7 +127,7 @@ TEST_CASE("a fence payload over 64 bytes closes only that client", "[robustness]
 }
 
 TEST_CASE("a fence from a client that did not list Fence closes only that client", "[robustness][streaming]") {
-  ServedScene scene(small_server());
+  ServedScene scene(edges_server());
   RawSocket socket(scene.port());
   rfbsim::test::raw_rfb_handshake(socket);
   REQUIRE(socket.send_all(rfbsim::test::rfb_set_encodings({kRaw, kContinuousUpdates})));
@@ -138,7 +138,7 @@ TEST_CASE("a fence from a client that did not list Fence closes only that client
 }
 
 TEST_CASE("truncated 150 and 248 messages are dropped after the read timeout", "[robustness][streaming]") {
-  ServedScene scene(small_server());
+  ServedScene scene(edges_server());
   RawSocket socket(scene.port());
   negotiate_streaming(socket);
   SECTION("EnableContinuousUpdates cut after 3 bytes") {
@@ -156,7 +156,7 @@ TEST_CASE("truncated 150 and 248 messages are dropped after the read timeout", "
 
 TEST_CASE("a client's fence request is answered with Request, SyncNext and unknown bits cleared",
           "[robustness][streaming]") {
-  ServedScene scene(small_server());
+  ServedScene scene(edges_server());
   RawSocket socket(scene.port());
   const auto init = negotiate_streaming(socket);
   constexpr std::uint32_t kAsked = (1U << 31) | (1U << 2) | (1U << 0) | (1U << 20);  // Request SyncNext BlockBefore ?
@@ -170,7 +170,7 @@ TEST_CASE("a client's fence request is answered with Request, SyncNext and unkno
 }
 
 TEST_CASE("unasked fence answers are ignored and the client stays served", "[robustness][streaming]") {
-  ServedScene scene(small_server());
+  ServedScene scene(edges_server());
   RawSocket socket(scene.port());
   const auto init = negotiate_streaming(socket);
   // The first answers the server's announcement fence; the rest match nothing.
@@ -183,7 +183,7 @@ TEST_CASE("unasked fence answers are ignored and the client stays served", "[rob
 
 TEST_CASE("ContinuousUpdates push without requests, ping after each update, and end on disable",
           "[robustness][streaming]") {
-  ServedScene scene(small_server());
+  ServedScene scene(edges_server());
   RawSocket socket(scene.port());
   const auto init = rfbsim::test::raw_rfb_handshake(socket);
   const rfbsim::test::ReadExact read = [&](std::size_t n, std::vector<std::uint8_t>& out) {

@@ -21,15 +21,15 @@ namespace {
 using namespace std::chrono_literals;
 using rfbsim::test::WsTestClient;
 
-constexpr int kWidth = 64;
-constexpr int kHeight = 48;
+constexpr int kHandshakeWidth = 64;
+constexpr int kHandshakeHeight = 48;
 
 // A small gradient so that every pixel's value is known exactly.
 std::vector<std::uint8_t> gradient_frame() {
-  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(kWidth) * kHeight * 4U);
-  for (int y = 0; y < kHeight; ++y) {
-    for (int x = 0; x < kWidth; ++x) {
-      std::uint8_t* p = &pixels[(static_cast<std::size_t>(y) * kWidth + static_cast<std::size_t>(x)) * 4U];
+  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(kHandshakeWidth) * kHandshakeHeight * 4U);
+  for (int y = 0; y < kHandshakeHeight; ++y) {
+    for (int x = 0; x < kHandshakeWidth; ++x) {
+      std::uint8_t* p = &pixels[(static_cast<std::size_t>(y) * kHandshakeWidth + static_cast<std::size_t>(x)) * 4U];
       p[0] = static_cast<std::uint8_t>(x * 4);
       p[1] = static_cast<std::uint8_t>(y * 5);
       p[2] = static_cast<std::uint8_t>(200 - x - y);
@@ -47,8 +47,8 @@ TEST_CASE("websocketpp client completes the RFB handshake over WebSocket and get
   std::mutex seen_mutex;
   std::vector<rfbsim::ClientInfo> seen;
   rfbsim::ServerOptions options;
-  options.width = kWidth;
-  options.height = kHeight;
+  options.width = kHandshakeWidth;
+  options.height = kHandshakeHeight;
   options.desktop_name = "ws-handshake-test";
   options.json_routes["/ping.json"] = [] { return std::string(R"({"pong":42})"); };
   options.on_connect = [&](const rfbsim::ClientInfo& info) {
@@ -57,7 +57,7 @@ TEST_CASE("websocketpp client completes the RFB handshake over WebSocket and get
   };
   rfbsim::Server server(options);
   const auto frame = gradient_frame();
-  server.submit(rfbsim::FrameView{frame.data(), kWidth, kHeight, 0});
+  server.submit(rfbsim::FrameView{frame.data(), kHandshakeWidth, kHandshakeHeight, 0});
 
   // The opening handshake must carry Origin (libvncserver refuses it otherwise).
   WsTestClient ws(server.port(), "/websockify", "http://127.0.0.1:" + std::to_string(server.port()), "binary");
@@ -69,8 +69,8 @@ TEST_CASE("websocketpp client completes the RFB handshake over WebSocket and get
 
   // RFB handshake over binary messages; ServerInit must describe the server's options.
   const auto init = rfbsim::test::rfb_client_handshake(read, write);
-  CHECK(init.width == kWidth);
-  CHECK(init.height == kHeight);
+  CHECK(init.width == kHandshakeWidth);
+  CHECK(init.height == kHandshakeHeight);
   CHECK(init.name == "ws-handshake-test");
   CHECK(init.bits_per_pixel == 32);
   CHECK(init.true_colour);
@@ -93,7 +93,7 @@ TEST_CASE("websocketpp client completes the RFB handshake over WebSocket and get
 
   // Ask for Raw pixels of the whole frame: the update must carry exactly the submitted picture.
   REQUIRE(write(rfbsim::test::rfb_set_encodings({0})));
-  REQUIRE(write(rfbsim::test::rfb_update_request(false, 0, 0, kWidth, kHeight)));
+  REQUIRE(write(rfbsim::test::rfb_update_request(false, 0, 0, kHandshakeWidth, kHandshakeHeight)));
   const auto rects = rfbsim::test::rfb_read_raw_update(read, init.bits_per_pixel / 8);
   REQUIRE_FALSE(rects.empty());
   long covered = 0;
@@ -105,13 +105,13 @@ TEST_CASE("websocketpp client completes the RFB handshake over WebSocket and get
         // The server's pixel format keeps red in the lowest byte: Raw bytes are R, G, B, X.
         const std::uint8_t* got = &rect.pixels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(rect.w) +
                                                 static_cast<std::size_t>(x)) * 4U];
-        const std::uint8_t* want = &frame[(static_cast<std::size_t>(rect.y + y) * kWidth +
+        const std::uint8_t* want = &frame[(static_cast<std::size_t>(rect.y + y) * kHandshakeWidth +
                                            static_cast<std::size_t>(rect.x + x)) * 4U];
         if (got[0] != want[0] || got[1] != want[1] || got[2] != want[2]) ++wrong_pixels;
       }
     }
   }
-  CHECK(covered == static_cast<long>(kWidth) * kHeight);
+  CHECK(covered == static_cast<long>(kHandshakeWidth) * kHandshakeHeight);
   CHECK(wrong_pixels == 0);
   CHECK(ws.text_messages() == 0);
   // Counted once the server's write returns, which may be a moment after the client has read it all.
@@ -130,8 +130,8 @@ TEST_CASE("websocketpp client completes the RFB handshake over WebSocket and get
 TEST_CASE("a server that shuts down says so to WebSocket clients with a going-away close frame",
           "[robustness][websocket]") {
   rfbsim::ServerOptions options;
-  options.width = kWidth;
-  options.height = kHeight;
+  options.width = kHandshakeWidth;
+  options.height = kHandshakeHeight;
   auto server = std::make_unique<rfbsim::Server>(options);
   WsTestClient ws(server->port(), "/websockify", "http://127.0.0.1:" + std::to_string(server->port()), "binary");
   const rfbsim::test::ReadExact read = [&ws](std::size_t n, std::vector<std::uint8_t>& out) {

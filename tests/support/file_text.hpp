@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// file_text: a file's whole content, for tests that check what a program wrote. Header-only.
+// Text helpers for tests that check what a program wrote or give it files to read: a file's whole content,
+// writing one, and whether a text contains a part. Header-only.
 #pragma once
 
 #include <filesystem>
@@ -16,5 +17,14 @@ inline std::string file_text(const std::filesystem::path& file) {
   text << in.rdbuf();
   return text.str();
 }
+
+/// Writes `text` as the whole of `file`, creating its folder first.
+inline void write_text(const std::filesystem::path& file, const std::string& text) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << text;
+}
+
+/// Whether `text` contains `part`.
+inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 }  // namespace rfbsim::test

@@ -24,6 +24,8 @@ extern "C" {
 #include <map>
 #include <stdexcept>
 
+#include "rfb_client_messages.hpp"
+
 namespace rfbsim::test {
 
 namespace {
@@ -63,25 +65,6 @@ void put32(std::vector<std::uint8_t>& out, std::uint32_t v) {
   put16(out, v & 0xffffU);
 }
 
-std::uint32_t clamp16(int v) { return static_cast<std::uint32_t>(std::clamp(v, 0, 65535)); }
-
-std::vector<std::uint8_t> update_request_message(bool incremental, int width, int height) {
-  std::vector<std::uint8_t> out{3, static_cast<std::uint8_t>(incremental ? 1 : 0)};
-  put16(out, 0);
-  put16(out, 0);
-  put16(out, clamp16(width));
-  put16(out, clamp16(height));
-  return out;
-}
-
-std::vector<std::uint8_t> enable_continuous_message(bool enable, int width, int height) {
-  std::vector<std::uint8_t> out{150, static_cast<std::uint8_t>(enable ? 1 : 0)};
-  put16(out, 0);
-  put16(out, 0);
-  put16(out, clamp16(width));
-  put16(out, clamp16(height));
-  return out;
-}
 
 std::string rect_text(int x, int y, int w, int h) {
   return std::to_string(w) + "x" + std::to_string(h) + " at (" + std::to_string(x) + ", " + std::to_string(y) + ")";
@@ -555,8 +538,8 @@ void H264RfbClient::send_key(std::uint32_t keysym, bool down) {
 
 void H264RfbClient::send_pointer(int x, int y, int buttons) {
   std::vector<std::uint8_t> message{5, static_cast<std::uint8_t>(buttons)};
-  put16(message, clamp16(x));
-  put16(message, clamp16(y));
+  put_u16_clamped(message, x);
+  put_u16_clamped(message, y);
   send_bytes(message);
 }
 

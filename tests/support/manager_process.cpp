@@ -2,7 +2,10 @@
 // ManagerUnderTest and its helpers: HTTP on loopback, the index through SQLite, processes through /proc.
 #include "manager_process.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <sqlite3.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -268,6 +271,26 @@ std::string token_from_redirect(const net::HttpResponse& response) {
   return value.substr(3, 32);
 }
 
+net::HttpResponse admin_post(const ManagerUnderTest& manager, const std::string& path, bool admin_header) {
+  return net::http_request(manager.port(), "POST " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " +
+                                               kAdminToken + "\r\n" + (admin_header ? "X-Rfbsim-Admin: 1\r\n" : "") +
+                                               "Content-Length: 0\r\nConnection: close\r\n\r\n");
+}
+
+int free_loopback_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) throw std::runtime_error("free_loopback_port: socket failed");
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  const bool bound = ::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0 &&
+                     ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0;
+  ::close(fd);
+  if (!bound) throw std::runtime_error("free_loopback_port: no loopback port to bind");
+  return ntohs(address.sin_port);
+}
+
 bool process_exists(pid_t pid) {
   const auto stat = read_proc_stat(pid);
   return stat && stat->state != 'Z';
@@ -296,14 +319,5 @@ std::vector<int> listening_ports() {
   return ports;
 }
 
-bool eventually(const std::function<bool()>& done, std::chrono::milliseconds timeout,
-                std::chrono::milliseconds interval) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  for (;;) {
-    if (done()) return true;
-    if (std::chrono::steady_clock::now() >= deadline) return false;
-    std::this_thread::sleep_for(interval);
-  }
-}
 
 }  // namespace rfbsim::test

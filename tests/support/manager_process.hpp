@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "eventually.hpp"
 #include "http_client.hpp"
 #include "sim_process.hpp"
 
@@ -132,6 +133,15 @@ class ManagerUnderTest {
 /// The token in a 302 to /s/<token>/ ("" when the response is not such a redirect).
 std::string token_from_redirect(const net::HttpResponse& response);
 
+/// The admin token the process tests give their managers (--admin-token).
+inline constexpr const char* kAdminToken = "test-admin-token-0123456789";
+
+/// POST `path` to `manager` with kAdminToken and, unless told not to, the admin API's X-Rfbsim-Admin header.
+net::HttpResponse admin_post(const ManagerUnderTest& manager, const std::string& path, bool admin_header = true);
+
+/// A loopback TCP port that was free a moment ago (bound as port 0, read back, released).
+int free_loopback_port();
+
 /// Whether a process with this id exists (zombies count as gone).
 bool process_exists(pid_t pid);
 
@@ -140,9 +150,5 @@ bool group_has_running_member(pid_t pgid);
 
 /// TCP ports in LISTEN state on this machine (from /proc/net/tcp).
 std::vector<int> listening_ports();
-
-/// Waits until `done()` holds, checking every `interval`; false after `timeout`.
-bool eventually(const std::function<bool()>& done, std::chrono::milliseconds timeout,
-                std::chrono::milliseconds interval = std::chrono::milliseconds(20));
 
 }  // namespace rfbsim::test

@@ -16,6 +16,8 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "rfb_client_messages.hpp"
+
 namespace rfbsim::test {
 
 namespace {
@@ -34,21 +36,6 @@ rfbBool resize_framebuffer(rfbClient* client) {
   client->updateRect.h = client->height;
   SetFormatAndEncodings(client);
   return TRUE;
-}
-
-void put_u16(std::vector<std::uint8_t>& out, int value) {
-  out.push_back(static_cast<std::uint8_t>(value >> 8));
-  out.push_back(static_cast<std::uint8_t>(value));
-}
-
-// EnableContinuousUpdates (150): U8 enable, U16 x, y, w, h.
-std::vector<std::uint8_t> enable_continuous_message(bool enable, int width, int height) {
-  std::vector<std::uint8_t> out{150, static_cast<std::uint8_t>(enable ? 1 : 0)};
-  put_u16(out, 0);
-  put_u16(out, 0);
-  put_u16(out, width);
-  put_u16(out, height);
-  return out;
 }
 
 // libvncclient sends an incremental update request after each update unless the server's

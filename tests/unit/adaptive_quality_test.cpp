@@ -15,7 +15,7 @@ using rfbsim::detail::quality_ladder;
 using rfbsim::detail::QualityLevel;
 using TimePoint = AdaptiveQuality::TimePoint;
 
-const TimePoint t0 = TimePoint{} + 1h;
+const TimePoint t_start = TimePoint{} + 1h;
 
 std::vector<int> qualities(const std::vector<QualityLevel>& ladder) {
   std::vector<int> q;
@@ -23,13 +23,13 @@ std::vector<int> qualities(const std::vector<QualityLevel>& ladder) {
   return q;
 }
 
-// A 25 fps stream on a fake clock: frame k is offered at t0 + 40 ms * k, as the server would drive it.
+// A 25 fps stream on a fake clock: frame k is offered at t_start + 40 ms * k, as the server would drive it.
 struct Stream {
   AdaptiveQuality aq;
   int tick = 0;
   std::vector<int> changes;  // ticks at which the level changed
 
-  [[nodiscard]] TimePoint now() const { return t0 + tick * 40ms; }
+  [[nodiscard]] TimePoint now() const { return t_start + tick * 40ms; }
   // One frame: offered, the rules applied, then (unless held) encoded at current() and sent.
   void frame(bool held, std::size_t bytes, double rate) {
     aq.frame_offered(now(), held);
@@ -42,11 +42,18 @@ struct Stream {
   }
 };
 
-// With every frame held from t0, the first step down comes at tick 38: 1.5 s hold-off, 40 ms ticks.
+// With every frame held from t_start, the first step down comes at tick 38: 1.5 s hold-off, 40 ms ticks.
 void step_down_once(Stream& s) {
   s.run_until(39, true, 0, 0);
   REQUIRE(s.changes == std::vector<int>{38});
   REQUIRE(s.aq.level() == 1);
+}
+
+// After step_down_once: steps up after the 3 s calm, then fails at once and steps down again.
+void fail_one_step_up(Stream& s) {
+  s.run_until(114, false, 10000, 0);  // up at tick 113 (4.52 s)
+  s.run_until(152, true, 0, 0);       // held at once: down after the hold-off, at 6.04 s
+  REQUIRE(s.changes == std::vector<int>{38, 113, 151});
 }
 
 }  // namespace
@@ -128,13 +135,19 @@ TEST_CASE("the quality steps up after a calm only when the rate allows", "[adapt
   }
 }
 
-TEST_CASE("a failed step up doubles the next wait; a lasting one resets it", "[adaptive_quality]") {
+TEST_CASE("a failed step up doubles the next wait", "[adaptive_quality]") {
   Stream s;
   step_down_once(s);
-  s.run_until(114, false, 10000, 0);  // up at tick 113 (4.52 s)
-  s.run_until(152, true, 0, 0);       // held at once: down after the hold-off, at 6.04 s
-  REQUIRE(s.changes == std::vector<int>{38, 113, 151});
+  fail_one_step_up(s);
   s.run_until(400, false, 10000, 0);  // the calm must now last 6 s: up at 12.04 s
+  CHECK(s.changes == std::vector<int>{38, 113, 151, 301});
+}
+
+TEST_CASE("a lasting step up resets a doubled wait", "[adaptive_quality]") {
+  Stream s;
+  step_down_once(s);
+  fail_one_step_up(s);
+  s.run_until(400, false, 10000, 0);  // the doubled wait: up at 12.04 s
   REQUIRE(s.changes == std::vector<int>{38, 113, 151, 301});
   s.run_until(600, false, 10000, 0);  // 12 s at the top: the probation passed
   s.run_until(607, true, 0, 0);       // 7 of 25 held at tick 606: down again
@@ -151,7 +164,7 @@ namespace {
 struct BorderlineLink {
   double capacity;
   std::vector<std::size_t> sizes;
-  TimePoint drained = t0;
+  TimePoint drained = t_start;
   int ticks_at_level_one = 0;
 
   void run(Stream& s, int ticks) {

@@ -70,7 +70,7 @@ TEST_CASE("a new connection starts in slow start with the initial window", "[con
   CHECK_FALSE(cc.got_pong(t0));  // nothing was asked
 }
 
-TEST_CASE("pongs acknowledge pings in order; base RTT is the lowest", "[congestion_control]") {
+TEST_CASE("pongs acknowledge pings in order", "[congestion_control]") {
   Sender s;
   s.update(t0, 1000);
   s.update(t0 + 40ms, 2000);
@@ -81,9 +81,18 @@ TEST_CASE("pongs acknowledge pings in order; base RTT is the lowest", "[congesti
   CHECK(s.cc.last_rtt() == 80ms);
   REQUIRE(s.cc.got_pong(t0 + 90ms));
   CHECK(s.cc.in_flight(t0 + 90ms) == 0);
+  CHECK(s.cc.last_rtt() == 50ms);
   CHECK(s.cc.outstanding_pings() == 0);
   CHECK_FALSE(s.cc.got_pong(t0 + 95ms));  // unasked: ignored
-  s.exchange(t0 + 100ms, 100, 70ms);
+}
+
+TEST_CASE("base RTT is the lowest RTT measured", "[congestion_control]") {
+  Sender s;
+  s.exchange(t0, 1000, 80ms);
+  CHECK(s.cc.base_rtt() == 80ms);
+  s.exchange(t0 + 90ms, 2000, 50ms);
+  CHECK(s.cc.base_rtt() == 50ms);
+  s.exchange(t0 + 150ms, 100, 70ms);
   CHECK(s.cc.last_rtt() == 70ms);
   CHECK(s.cc.base_rtt() == 50ms);
 }

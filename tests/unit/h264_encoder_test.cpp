@@ -19,6 +19,8 @@ extern "C" {
 #include <tuple>
 #include <vector>
 
+#include "skip.hpp"
+
 using rfbsim::detail::H264Encoder;
 using rfbsim::detail::h264_available;
 using rfbsim::detail::h264_level_idc;
@@ -213,10 +215,7 @@ TEST_CASE("h264_level_idc picks the lowest level from 3.1 up that fits", "[h264]
 }
 
 TEST_CASE("H264Encoder refuses sizes H.264 4:2:0 cannot carry, naming the cause", "[h264]") {
-  if (!h264_available()) {
-    WARN("this libavcodec has no libx264: H264Encoder not tested");
-    return;
-  }
+  if (!h264_available()) RFBSIM_SKIP("this libavcodec has no libx264 encoder: H264Encoder not tested");
   CHECK_THROWS_WITH(H264Encoder(641, 480, 30), Catch::Contains("641x480") && Catch::Contains("even"));
   CHECK_THROWS_WITH(H264Encoder(640, 479, 30), Catch::Contains("odd"));
   CHECK_THROWS_WITH(H264Encoder(8, 8, 30), Catch::Contains("too small"));
@@ -230,10 +229,7 @@ TEST_CASE("H264Encoder refuses sizes H.264 4:2:0 cannot carry, naming the cause"
 }
 
 TEST_CASE("H264Encoder writes one decodable constrained-baseline picture per call", "[h264]") {
-  if (!h264_available()) {
-    WARN("this libavcodec has no libx264: H264Encoder not tested");
-    return;
-  }
+  if (!h264_available()) RFBSIM_SKIP("this libavcodec has no libx264 encoder: H264Encoder not tested");
   // Bounds on the mean absolute difference, decoded vs source, RGB and BT.601 luma. At 720p the gradient
   // moves under 0.4 levels a pixel: 8-bit limited-range YUV rounds by under 0.5, CRF 23 barely touches a
   // smooth gradient; measured 0.61 (RGB) and 0.40 (luma). At 64x48 it climbs 4 levels a pixel and the
@@ -279,10 +275,7 @@ TEST_CASE("H264Encoder writes one decodable constrained-baseline picture per cal
 }
 
 TEST_CASE("H264Encoder starts an IDR with SPS and PPS when asked", "[h264]") {
-  if (!h264_available()) {
-    WARN("this libavcodec has no libx264: H264Encoder not tested");
-    return;
-  }
+  if (!h264_available()) RFBSIM_SKIP("this libavcodec has no libx264 encoder: H264Encoder not tested");
   const int width = 160, height = 96;
   H264Encoder encoder(width, height, 30);
   Decoder decoder;
@@ -308,10 +301,7 @@ TEST_CASE("H264Encoder starts an IDR with SPS and PPS when asked", "[h264]") {
 }
 
 TEST_CASE("H264Encoder: a padded stride reads the same pixels", "[h264]") {
-  if (!h264_available()) {
-    WARN("this libavcodec has no libx264: H264Encoder not tested");
-    return;
-  }
+  if (!h264_available()) RFBSIM_SKIP("this libavcodec has no libx264 encoder: H264Encoder not tested");
   const int width = 64, height = 48, stride = width * 4 + 32;
   const Bytes tight = gradient_with_square(width, height, 0);
   Bytes padded(static_cast<std::size_t>(stride) * height, 0xEE);
@@ -326,10 +316,7 @@ TEST_CASE("H264Encoder: a padded stride reads the same pixels", "[h264]") {
 }
 
 TEST_CASE("H264Encoder::set_max_bitrate caps a busy stream from the next picture", "[h264]") {
-  if (!h264_available()) {
-    WARN("this libavcodec has no libx264: H264Encoder not tested");
-    return;
-  }
+  if (!h264_available()) RFBSIM_SKIP("this libavcodec has no libx264 encoder: H264Encoder not tested");
   const int width = 320, height = 240, fps = 30;
   H264Encoder encoder(width, height, fps);
   CHECK(encoder.max_bitrate() == 14'000'000);  // level 3.1's maximum

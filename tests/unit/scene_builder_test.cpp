@@ -90,6 +90,25 @@ double check_inside(const std::vector<DrawItem>& items, const rfbsim::sim::Prop&
   return top;
 }
 
+// The items of a robot at (3, 5) facing 0.4 rad, with its head ahead and turned by head_yaw 0.9.
+struct RobotHeadViews {
+  std::vector<DrawItem> ahead;
+  std::vector<DrawItem> turned;
+};
+
+RobotHeadViews robot_head_views() {
+  rfbsim::sim::Robot robot;
+  robot.pose = {3.0, 5.0, 0.4};
+  RobotHeadViews views;
+  rfbsim::sim::append_robot(views.ahead, robot);
+  robot.head_yaw = 0.9;
+  rfbsim::sim::append_robot(views.turned, robot);
+  REQUIRE(views.ahead.size() == rfbsim::sim::kRobotBodyItems + rfbsim::sim::kRobotHeadItems + 2);
+  REQUIRE(views.ahead.size() < 15);  // small enough to cost nothing per frame
+  REQUIRE(views.turned.size() == views.ahead.size());
+  return views;
+}
+
 }  // namespace
 
 TEST_CASE("scene: each person's head is at their position and height, the taller one higher", "[scene]") {
@@ -245,22 +264,15 @@ TEST_CASE("scene: building is deterministic and a warehouse stays within the ite
   CHECK(scene.items.size() < 2500);
 }
 
-TEST_CASE("scene: the robot's head, face and eyes turn with head_yaw; its body and shadow do not", "[scene]") {
+TEST_CASE("scene: the robot's head, face and eyes turn with head_yaw", "[scene]") {
   using rfbsim::sim::kRobotBodyItems;
   using rfbsim::sim::kRobotHeadItems;
-  rfbsim::sim::Robot robot;
-  robot.pose = {3.0, 5.0, 0.4};
-  std::vector<DrawItem> ahead, turned;
-  rfbsim::sim::append_robot(ahead, robot);
-  robot.head_yaw = 0.9;
-  rfbsim::sim::append_robot(turned, robot);
-  REQUIRE(ahead.size() == kRobotBodyItems + kRobotHeadItems + 2);
-  REQUIRE(ahead.size() < 15);  // small enough to cost nothing per frame
-  REQUIRE(turned.size() == ahead.size());
-  for (std::size_t i = 0; i < ahead.size(); ++i) {
+  const RobotHeadViews views = robot_head_views();
+  const std::vector<DrawItem>& ahead = views.ahead;
+  const std::vector<DrawItem>& turned = views.turned;
+  for (std::size_t i = kRobotBodyItems; i < kRobotBodyItems + kRobotHeadItems; ++i) {
     INFO("item " << i);
-    const bool head = i >= kRobotBodyItems && i < kRobotBodyItems + kRobotHeadItems;
-    CHECK(ahead[i].model.matrix().isApprox(turned[i].model.matrix()) == !head);
+    CHECK_FALSE(ahead[i].model.matrix().isApprox(turned[i].model.matrix()));
   }
   // The eyes (black) sit either side of the head's forward axis: their midpoint points along the body's
   // yaw plus the head's, 0.1175 m out (1.02 x the head's 0.1152 m radius), at 0.43 m.
@@ -275,12 +287,30 @@ TEST_CASE("scene: the robot's head, face and eyes turn with head_yaw; its body a
   };
   CHECK(eyes_direction(ahead) == Approx(0.4).margin(1e-5));
   CHECK(eyes_direction(turned) == Approx(1.3).margin(1e-5));
+}
+
+TEST_CASE("scene: the robot's body and shadow do not turn with head_yaw", "[scene]") {
+  using rfbsim::sim::kRobotBodyItems;
+  using rfbsim::sim::kRobotHeadItems;
+  const RobotHeadViews views = robot_head_views();
+  const std::vector<DrawItem>& ahead = views.ahead;
+  const std::vector<DrawItem>& turned = views.turned;
+  for (std::size_t i = 0; i < ahead.size(); ++i) {
+    if (i >= kRobotBodyItems && i < kRobotBodyItems + kRobotHeadItems) continue;  // the head
+    INFO("item " << i);
+    CHECK(ahead[i].model.matrix().isApprox(turned[i].model.matrix()));
+  }
   // The sensor window and the heart light stay on the body's front whichever way the head looks.
   for (const std::size_t i : {kRobotBodyItems - 2, kRobotBodyItems - 1}) {
     const Eigen::Vector3f front = turned[i].model.translation();
     CHECK(std::atan2(static_cast<double>(front.y()) - 5.0, static_cast<double>(front.x()) - 3.0) ==
           Approx(0.4).margin(1e-5));
   }
+}
+
+TEST_CASE("scene: the robot with its head turned reaches its height and fills its footprint, no further",
+          "[scene]") {
+  const std::vector<DrawItem> turned = robot_head_views().turned;
   // The top of the dome is the robot's height, turned or not, and the body fills its footprint without
   // reaching past it: every part is a sphere or cylinder turned about z, so its reach along a horizontal
   // direction u is its centre's plus half the length of its unit shape's axes projected on u.
@@ -302,7 +332,7 @@ TEST_CASE("scene: the robot's head, face and eyes turn with head_yaw; its body a
   CHECK(widest == Approx(0.16).margin(1e-4));
 }
 
-TEST_CASE("scene: the robot's heart light tells the navigator's state; a broken pose draws nothing", "[scene]") {
+TEST_CASE("scene: the robot's heart light tells the navigator's state", "[scene]") {
   const std::size_t light = rfbsim::sim::kRobotBodyItems - 1;
   rfbsim::sim::Robot robot;
   std::vector<DrawItem> moving, failed;
@@ -317,7 +347,10 @@ TEST_CASE("scene: the robot's heart light tells the navigator's state; a broken 
   }
   CHECK(failed[light].color.x() > 0.9f);  // red
   CHECK(failed[light].color.y() < 0.3f);
+}
 
+TEST_CASE("scene: a robot with a broken pose or no radius draws nothing", "[scene]") {
+  rfbsim::sim::Robot robot;
   std::vector<DrawItem> none;
   robot.pose.x = std::nan("");
   rfbsim::sim::append_robot(none, robot);
@@ -326,9 +359,19 @@ TEST_CASE("scene: the robot's heart light tells the navigator's state; a broken 
   robot.radius = 0.0;
   rfbsim::sim::append_robot(none, robot);
   CHECK(none.empty());
-  robot.radius = 0.16;
-  robot.head_yaw = std::nan("");  // a broken head angle: the head looks ahead
-  rfbsim::sim::append_robot(none, robot);
-  REQUIRE(none.size() == moving.size());
-  for (const DrawItem& item : none) CHECK(item.model.matrix().allFinite());
+}
+
+TEST_CASE("scene: a robot with a broken head angle is drawn whole, its head looking ahead", "[scene]") {
+  rfbsim::sim::Robot robot;
+  robot.pose = {1.0, 0.0, 0.0};
+  std::vector<DrawItem> ahead, broken;
+  rfbsim::sim::append_robot(ahead, robot);
+  robot.head_yaw = std::nan("");
+  rfbsim::sim::append_robot(broken, robot);
+  REQUIRE(broken.size() == ahead.size());
+  for (std::size_t i = 0; i < broken.size(); ++i) {
+    INFO("item " << i);
+    CHECK(broken[i].model.matrix().allFinite());
+    CHECK(broken[i].model.matrix().isApprox(ahead[i].model.matrix()));
+  }
 }

@@ -23,11 +23,11 @@ using rfbsim::test::ScriptedKey;
 namespace {
 
 // Out of the dock towards the robot's route, a turn, a run, a stop: 30 s at 60 Hz with the robot on its mission.
-const std::vector<ScriptedKey> kScript = {
+const std::vector<ScriptedKey> kGoldenScript = {
     {0, 'w', true},     {240, 'd', true},  {300, 'd', false}, {600, 'W', true},  {660, 'w', false},
     {700, 'a', true},   {790, 'a', false}, {800, 'w', true},  {1200, 'W', false}, {1500, 'w', false},
 };
-constexpr std::uint64_t kTicks = 1800;
+constexpr std::uint64_t kGoldenTicks = 1800;
 constexpr std::uint64_t kSeed = 11;
 
 // The digest of the run above. Update it only for a deliberate change of behaviour, saying why in the commit.
@@ -64,8 +64,8 @@ std::string trajectory_digest(const std::vector<std::vector<double>>& trace) {
 
 TEST_CASE("the warehouse with seed 11 and the golden key script gives the checked-in trajectory digest") {
   auto simulation = rfbsim::test::make_scenario_simulation("warehouse", kSeed, {}, true);
-  const auto trace = rfbsim::test::run_scripted(*simulation, kScript, kTicks);
-  REQUIRE(trace.size() == kTicks);
+  const auto trace = rfbsim::test::run_scripted(*simulation, kGoldenScript, kGoldenTicks);
+  REQUIRE(trace.size() == kGoldenTicks);
   // The run did something worth pinning: the avatar walked and the robot drove.
   CHECK(simulation->world().avatar.distance_walked > 5.0);
   const auto& robot_start = trace.front();

@@ -21,7 +21,7 @@ bool finite(const std::vector<double>& values) {
 
 }  // namespace
 
-TEST_CASE("ten minutes of warehouse: nobody leaves the map or stands in a wall, no NaN") {
+TEST_CASE("ten minutes of warehouse: nobody leaves the map or stands in a wall, no NaN", "[busy]") {
   auto simulation = rfbsim::test::make_scenario_simulation("warehouse", 5, {}, true);
   const auto& world = simulation->world();
   // The participant wanders: walk, turn a little, walk, for the whole ten minutes.

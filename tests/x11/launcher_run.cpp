@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -44,9 +45,14 @@ std::chrono::milliseconds left_until(Clock::time_point deadline) {
 
 }  // namespace
 
+std::string xvnc_path() {
+  const char* chosen = std::getenv("RFBSIM_XVNC");
+  return chosen != nullptr && *chosen != '\0' ? chosen : "/usr/bin/Xvnc";
+}
+
 std::string x11_missing() {
-  if (::access("/usr/bin/Xvnc", X_OK) != 0) {
-    return "/usr/bin/Xvnc is missing (apt-get install tigervnc-standalone-server)";
+  if (const std::string xvnc = xvnc_path(); ::access(xvnc.c_str(), X_OK) != 0) {
+    return xvnc + " is missing (apt-get install tigervnc-standalone-server)";
   }
   if (std::string(kKeyEchoBinary).empty()) return "rfbsim_x11_key_echo was not built (libx11-dev missing)";
   return "";
@@ -55,6 +61,10 @@ std::string x11_missing() {
 LauncherRun::LauncherRun(const std::string& folder, const std::vector<std::string>& launcher_args,
                          const std::vector<std::string>& program) {
   std::vector<std::string> args{kX11SessionBinary, "--ready-fd", "3"};
+  // The chosen Xvnc, unless the test names its own (the launcher takes each flag once).
+  if (std::find(launcher_args.begin(), launcher_args.end(), "--xvnc") == launcher_args.end()) {
+    args.insert(args.end(), {"--xvnc", xvnc_path()});
+  }
   args.insert(args.end(), launcher_args.begin(), launcher_args.end());
   args.emplace_back("--");
   args.insert(args.end(), program.begin(), program.end());

@@ -16,12 +16,17 @@ namespace rfbsim::test {
 extern const char* const kX11SessionBinary;
 extern const char* const kKeyEchoBinary;
 
-/// Whether Xvnc and the key-echo program exist, so that a process test can run; else the reason to skip.
+/// The Xvnc the launcher runs: $RFBSIM_XVNC where set (a test of the skips points it at a missing file), else
+/// Debian's /usr/bin/Xvnc.
+std::string xvnc_path();
+
+/// "" when Xvnc and the key-echo program exist, so that a process test can run; else what is missing.
 std::string x11_missing();
 
 class LauncherRun {
  public:
-  /// Starts `launcher_args` (flags before "--", --ready-fd 3 added) and `program` after "--", in `folder`.
+  /// Starts `launcher_args` (flags before "--", --ready-fd 3 added, and --xvnc xvnc_path() unless they name
+  /// one) and `program` after "--", in `folder`.
   /// Throws std::runtime_error when it cannot be started.
   LauncherRun(const std::string& folder, const std::vector<std::string>& launcher_args,
               const std::vector<std::string>& program);

@@ -2,14 +2,9 @@
 // DistanceGrid: a bucket-queue Dijkstra brushfire from the target cells over the free cells of the local costmap.
 #include "robot/planning/distance_grid.hpp"
 
+#include "robot/planning/grid_neighbours.hpp"
+
 namespace rfbsim::sim {
-
-namespace {
-
-constexpr int kDc[8] = {1, -1, 0, 0, 1, -1, 1, -1};
-constexpr int kDr[8] = {0, 0, 1, -1, 1, 1, -1, -1};
-
-}  // namespace
 
 void DistanceGrid::compute(const CostmapGrid& grid, const std::vector<std::int32_t>& targets) {
   width_ = grid.width;
@@ -42,8 +37,8 @@ void DistanceGrid::compute(const CostmapGrid& grid, const std::vector<std::int32
       const int col = index % width_;
       const int row = index / width_;
       for (int k = 0; k < 8; ++k) {
-        const int ncol = col + kDc[k];
-        const int nrow = row + kDr[k];
+        const int ncol = col + kNeighbourDc[k];
+        const int nrow = row + kNeighbourDr[k];
         if (ncol < 0 || nrow < 0 || ncol >= width_ || nrow >= height_) continue;
         const std::size_t next = static_cast<std::size_t>(nrow) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(ncol);
         if (!walkable(next)) continue;

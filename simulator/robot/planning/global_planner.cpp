@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "robot/planning/grid_neighbours.hpp"
 #include "robot/planning/grid_point.hpp"
 #include "robot/planning/path_shortcut.hpp"
 
@@ -17,10 +18,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kSqrt2 = 1.4142135623730951;
-
-// The 8 neighbours: the 4 straight ones first, then the diagonals.
-constexpr int kDc[8] = {1, -1, 0, 0, 1, -1, 1, -1};
-constexpr int kDr[8] = {0, 0, 1, -1, 1, 1, -1, -1};
 
 // "(1.25, -0.50)" for reasons.
 std::string point_text(const Eigen::Vector2d& p) {
@@ -224,8 +221,8 @@ bool GlobalPlanner::search(const CostmapGrid& grid, Cell start, Cell goal, std::
     const int row = top.index / width;
     const bool from_blocked = !std::isfinite(step_cost_[costs[at]]);
     for (int k = 0; k < 8; ++k) {
-      const int ncol = col + kDc[k];
-      const int nrow = row + kDr[k];
+      const int ncol = col + kNeighbourDc[k];
+      const int nrow = row + kNeighbourDr[k];
       if (ncol < 0 || nrow < 0 || ncol >= width || nrow >= height) continue;
       const std::size_t next = static_cast<std::size_t>(nrow) * static_cast<std::size_t>(width) + static_cast<std::size_t>(ncol);
       if (closed_[next] != 0) continue;

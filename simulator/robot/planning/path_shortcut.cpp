@@ -12,11 +12,12 @@ namespace rfbsim::sim {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+// The cost of a cell that cannot be crossed (off the grid or lethal).
+constexpr double kImpassable = std::numeric_limits<double>::infinity();
 
 // The step cost of a cell, or +inf when it is off the grid or impassable; raises max_cost to its cost.
 double crossing_cost(const CostmapGrid& grid, Cell c, const std::array<double, 256>& step_cost, int& max_cost) {
-  if (!grid.in_bounds(c)) return kInf;
+  if (!grid.in_bounds(c)) return kImpassable;
   const std::uint8_t value = grid.costs[grid.index(c)];
   max_cost = std::max(max_cost, static_cast<int>(value));
   return step_cost[value];
@@ -28,7 +29,7 @@ double segment_cost(const CostmapGrid& grid, Cell a, Cell b, const std::array<do
                     int& max_cost) {
   max_cost = 0;
   double here = crossing_cost(grid, a, step_cost, max_cost);
-  if (!std::isfinite(here)) return kInf;
+  if (!std::isfinite(here)) return kImpassable;
   const int dc = b.col - a.col;
   const int dr = b.row - a.row;
   const long long adc = std::abs(dc);
@@ -56,7 +57,7 @@ double segment_cost(const CostmapGrid& grid, Cell a, Cell b, const std::array<do
       // Through a grid corner: both cells beside it must be passable, as for a diagonal step.
       if (!std::isfinite(crossing_cost(grid, {c.col + step_col, c.row}, step_cost, max_cost)) ||
           !std::isfinite(crossing_cost(grid, {c.col, c.row + step_row}, step_cost, max_cost))) {
-        return kInf;
+        return kImpassable;
       }
     }
     if (col_key <= row_key) {
@@ -68,7 +69,7 @@ double segment_cost(const CostmapGrid& grid, Cell a, Cell b, const std::array<do
       ++m;
     }
     here = crossing_cost(grid, c, step_cost, max_cost);
-    if (!std::isfinite(here)) return kInf;
+    if (!std::isfinite(here)) return kImpassable;
   }
   return cost + (1.0 - t_prev) * length * here;
 }

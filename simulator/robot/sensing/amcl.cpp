@@ -14,7 +14,7 @@ namespace rfbsim::sim {
 
 namespace {
 
-void require(bool ok, const char* what) {
+void require_amcl(bool ok, const char* what) {
   if (!ok) throw std::invalid_argument(std::string("AmclParams: ") + what);
 }
 
@@ -27,21 +27,21 @@ constexpr double kMinTrans = 0.01;
 
 Amcl::Amcl(const GridMap& map, AmclParams params, Pose2 initial, std::uint64_t seed)
     : params_(params), rng_(seed) {
-  require(params.min_particles >= 1 && params.max_particles >= params.min_particles,
+  require_amcl(params.min_particles >= 1 && params.max_particles >= params.min_particles,
           "need 1 <= min_particles <= max_particles");
   params_.particles = std::clamp(params.particles, params.min_particles, params.max_particles);
-  require(non_negative(params.odom_alpha1) && non_negative(params.odom_alpha2) &&
+  require_amcl(non_negative(params.odom_alpha1) && non_negative(params.odom_alpha2) &&
               non_negative(params.odom_alpha3) && non_negative(params.odom_alpha4),
           "odom_alpha1..4 must be >= 0");
-  require(non_negative(params.laser_z_hit) && non_negative(params.laser_z_rand) &&
+  require_amcl(non_negative(params.laser_z_hit) && non_negative(params.laser_z_rand) &&
               params.laser_z_hit + params.laser_z_rand > 0.0,
           "laser_z_hit and laser_z_rand must be >= 0, not both 0");
-  require(std::isfinite(params.laser_sigma_hit) && params.laser_sigma_hit > 0.0, "laser_sigma_hit must be > 0 m");
-  require(params.laser_max_beams >= 1, "laser_max_beams must be >= 1");
-  require(non_negative(params.update_min_d) && non_negative(params.update_min_a),
+  require_amcl(std::isfinite(params.laser_sigma_hit) && params.laser_sigma_hit > 0.0, "laser_sigma_hit must be > 0 m");
+  require_amcl(params.laser_max_beams >= 1, "laser_max_beams must be >= 1");
+  require_amcl(non_negative(params.update_min_d) && non_negative(params.update_min_a),
           "update_min_d and update_min_a must be >= 0");
-  require(params.resample_interval >= 1, "resample_interval must be >= 1");
-  require(non_negative(params.initial_cov_xx) && non_negative(params.initial_cov_yy) &&
+  require_amcl(params.resample_interval >= 1, "resample_interval must be >= 1");
+  require_amcl(non_negative(params.initial_cov_xx) && non_negative(params.initial_cov_yy) &&
               non_negative(params.initial_cov_aa),
           "initial_cov_xx, _yy and _aa must be >= 0");
   if (!(map.resolution > 0.0) || !std::isfinite(map.resolution)) {
@@ -50,7 +50,7 @@ Amcl::Amcl(const GridMap& map, AmclParams params, Pose2 initial, std::uint64_t s
   // The field checks laser_likelihood_max_dist.
   field_ = LikelihoodField(map, params.laser_likelihood_max_dist);
   const double cap_cells = params.laser_likelihood_max_dist / map.resolution;
-  require(cap_cells < 4096.0, "laser_likelihood_max_dist must be under 4096 map cells");
+  require_amcl(cap_cells < 4096.0, "laser_likelihood_max_dist must be under 4096 map cells");
   const auto key_of = [&map](double metres) {
     const double cells = metres / map.resolution;
     return static_cast<std::uint32_t>(std::lround(cells * cells));

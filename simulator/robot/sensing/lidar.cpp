@@ -18,7 +18,7 @@ namespace {
 // A full circle, up to rounding in how the caller wrote 2 pi.
 bool is_full_circle(double fov) { return fov >= 2.0 * std::numbers::pi - 1e-9; }
 
-void require(bool ok, const char* what) {
+void require_lidar(bool ok, const char* what) {
   if (!ok) throw std::invalid_argument(std::string("LidarParams: ") + what);
 }
 
@@ -50,13 +50,13 @@ double lidar_angle_increment(const LidarParams& params) {
 }
 
 void check_lidar_params(const LidarParams& params) {
-  require(params.beams >= 1, "beams must be at least 1");
-  require(std::isfinite(params.fov) && params.fov > 0.0 && params.fov <= 2.0 * std::numbers::pi + 1e-9,
+  require_lidar(params.beams >= 1, "beams must be at least 1");
+  require_lidar(std::isfinite(params.fov) && params.fov > 0.0 && params.fov <= 2.0 * std::numbers::pi + 1e-9,
           "fov must be in (0, 2 pi] rad");
-  require(std::isfinite(params.range_min) && params.range_min >= 0.0, "range_min must be >= 0 m");
-  require(std::isfinite(params.range_max) && params.range_max > params.range_min,
+  require_lidar(std::isfinite(params.range_min) && params.range_min >= 0.0, "range_min must be >= 0 m");
+  require_lidar(std::isfinite(params.range_max) && params.range_max > params.range_min,
           "range_max must be finite and above range_min");
-  require(std::isfinite(params.noise_stddev) && params.noise_stddev >= 0.0, "noise_stddev must be >= 0 m");
+  require_lidar(std::isfinite(params.noise_stddev) && params.noise_stddev >= 0.0, "noise_stddev must be >= 0 m");
 }
 
 std::optional<double> ray_circle_distance(const Eigen::Vector2d& origin, const Eigen::Vector2d& dir,

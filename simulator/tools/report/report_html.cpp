@@ -34,7 +34,7 @@ figcaption { font-size: 0.85em; color: #555; max-width: 40em; }
 )";
 
 // A table; header and cells arrive escaped. Cells that look like numbers are right-aligned.
-void table(std::string& out, const Row& header, const std::vector<Row>& rows) {
+void html_table(std::string& out, const Row& header, const std::vector<Row>& rows) {
   out += "<table><thead><tr>";
   for (const std::string& h : header) out += "<th>" + h + "</th>";
   out += "</tr></thead><tbody>\n";
@@ -49,11 +49,9 @@ void table(std::string& out, const Row& header, const std::vector<Row>& rows) {
   out += "</tbody></table>\n";
 }
 
-std::string group_name(const GroupSummary& g) {
+std::string html_group_name(const GroupSummary& g) {
   return g.all ? "all sessions" : "scenario " + html_escape(g.scenario.empty() ? "(unnamed)" : g.scenario);
 }
-
-std::string optional_cell(const std::optional<double>& v) { return v ? format_fixed(*v, 3) : ""; }
 
 void overview(std::string& out, const ReportData& data) {
   out += "<h2>Overview (% of sessions)</h2>\n";
@@ -61,7 +59,7 @@ void overview(std::string& out, const ReportData& data) {
   for (const Rate& r : summary_rates()) header.push_back("% " + html_escape(r.meaning));
   std::vector<Row> rows;
   for (const GroupSummary& g : data.groups) {
-    Row row = {group_name(g), std::to_string(g.sessions), std::to_string(g.excluded)};
+    Row row = {html_group_name(g), std::to_string(g.sessions), std::to_string(g.excluded)};
     for (const double pct : g.rate_percent) row.push_back(format_fixed(pct, 1));
     rows.push_back(row);
   }
@@ -69,12 +67,12 @@ void overview(std::string& out, const ReportData& data) {
   Row paper = {"SEAN-EP paper", std::to_string(kSeanSessions), ""};
   for (const Rate& r : summary_rates()) paper.push_back(r.paper_percent ? format_number(*r.paper_percent, 2) : "");
   rows.push_back(paper);
-  table(out, header, rows);
+  html_table(out, header, rows);
   out += "<p>" + html_escape(kPaperRowNote) + "</p>\n";
 
   out += "<h2>Measures (mean and median over the sessions that have a value)</h2>\n";
   for (const GroupSummary& g : data.groups) {
-    out += "<h3>" + group_name(g) + "</h3>\n";
+    out += "<h3>" + html_group_name(g) + "</h3>\n";
     rows.clear();
     for (std::size_t i = 0; i < summarized_columns().size(); ++i) {
       const Column& c = session_column(summarized_columns()[i]);
@@ -82,7 +80,7 @@ void overview(std::string& out, const ReportData& data) {
       rows.push_back({"<span title=\"" + html_escape(c.meaning) + "\">" + html_escape(c.name) + "</span>",
                       html_escape(c.unit), std::to_string(s.n), optional_cell(s.mean), optional_cell(s.median)});
     }
-    table(out, {"measure", "unit", "N", "mean", "median"}, rows);
+    html_table(out, {"measure", "unit", "N", "mean", "median"}, rows);
   }
 }
 
@@ -118,7 +116,7 @@ void session_table(std::string& out, const ReportData& data) {
     rows.push_back(row);
   }
   out += "<div class=\"wide\">";
-  table(out, header, rows);
+  html_table(out, header, rows);
   out += "</div>\n";
 }
 
@@ -148,7 +146,7 @@ void hosts(std::string& out, const ReportData& data) {
       for (const DuplicateUid& d : data.duplicates) {
         rows.push_back({html_escape(d.uid), html_escape(joined(d.hosts)), html_escape(joined(d.folders))});
       }
-      table(out, {"uid", "hosts", "sessions"}, rows);
+      html_table(out, {"uid", "hosts", "sessions"}, rows);
     }
   }
   if (!data.repeats.empty()) {
@@ -157,7 +155,7 @@ void hosts(std::string& out, const ReportData& data) {
     for (const RepeatedFolder& r : data.repeats) {
       rows.push_back({html_escape(r.folder), html_escape(r.same_as), html_escape(r.why)});
     }
-    table(out, {"left out", "reported", "why the same"}, rows);
+    html_table(out, {"left out", "reported", "why the same"}, rows);
   }
 }
 
@@ -170,13 +168,13 @@ void left_out(std::string& out, const ReportData& data) {
            "histograms.</p>\n";
     std::vector<Row> rows;
     for (const Exclusion& e : data.exclusions) rows.push_back({html_escape(e.reason), std::to_string(e.sessions)});
-    table(out, {"why", "sessions"}, rows);
+    html_table(out, {"why", "sessions"}, rows);
   }
   if (!data.skipped.empty()) {
     out += "<h2>Skipped sessions</h2>\n";
     std::vector<Row> rows;
     for (const SkippedSession& s : data.skipped) rows.push_back({html_escape(s.folder), html_escape(s.reason)});
-    table(out, {"folder", "reason"}, rows);
+    html_table(out, {"folder", "reason"}, rows);
   }
   if (!data.warnings.empty()) {
     out += "<h2>Warnings</h2>\n<ul>\n";

@@ -13,7 +13,7 @@ using Row = std::vector<std::string>;
 
 // A table. Cells arrive escaped: strings from the data through markdown_escape; column names, units and
 // numbers are ours and hold no markup.
-void table(std::string& out, const Row& header, const std::vector<Row>& rows) {
+void markdown_table(std::string& out, const Row& header, const std::vector<Row>& rows) {
   const auto line = [&](const Row& cells) {
     out += "|";
     for (const std::string& c : cells) out += " " + c + " |";
@@ -27,11 +27,9 @@ void table(std::string& out, const Row& header, const std::vector<Row>& rows) {
   out += "\n";
 }
 
-std::string group_name(const GroupSummary& g) {
+std::string markdown_group_name(const GroupSummary& g) {
   return g.all ? "all sessions" : "scenario " + markdown_escape(g.scenario.empty() ? "(unnamed)" : g.scenario);
 }
-
-std::string optional_cell(const std::optional<double>& v) { return v ? format_fixed(*v, 3) : ""; }
 
 std::string with_unit(const Column& c) { return c.unit.empty() ? c.name : c.name + " (" + c.unit + ")"; }
 
@@ -59,7 +57,7 @@ std::string markdown_report(const ReportData& data) {
   for (const Rate& r : summary_rates()) header.push_back("% " + r.meaning);
   std::vector<Row> rows;
   for (const GroupSummary& g : data.groups) {
-    Row row = {group_name(g), std::to_string(g.sessions), std::to_string(g.excluded)};
+    Row row = {markdown_group_name(g), std::to_string(g.sessions), std::to_string(g.excluded)};
     for (const double pct : g.rate_percent) row.push_back(format_fixed(pct, 1));
     rows.push_back(row);
   }
@@ -67,20 +65,20 @@ std::string markdown_report(const ReportData& data) {
   Row paper = {"SEAN-EP paper", std::to_string(kSeanSessions), ""};
   for (const Rate& r : summary_rates()) paper.push_back(r.paper_percent ? format_number(*r.paper_percent, 2) : "");
   rows.push_back(paper);
-  table(out, header, rows);
+  markdown_table(out, header, rows);
   out += std::string(kPaperRowNote) + "\n\n";
 
   // Mean and median of each measure, one table per group.
   out += "## Measures (mean and median over the sessions that have a value)\n\n";
   for (const GroupSummary& g : data.groups) {
-    out += "### " + group_name(g) + "\n\n";
+    out += "### " + markdown_group_name(g) + "\n\n";
     rows.clear();
     for (std::size_t i = 0; i < summarized_columns().size(); ++i) {
       const Column& c = session_column(summarized_columns()[i]);
       const Statistic& s = g.statistics[i];
       rows.push_back({c.name, c.unit, std::to_string(s.n), optional_cell(s.mean), optional_cell(s.median)});
     }
-    table(out, {"measure", "unit", "N", "mean", "median"}, rows);
+    markdown_table(out, {"measure", "unit", "N", "mean", "median"}, rows);
   }
 
   out += "## Sessions\n\n";
@@ -100,7 +98,7 @@ std::string markdown_report(const ReportData& data) {
     }
     rows.push_back(row);
   }
-  table(out, header, rows);
+  markdown_table(out, header, rows);
   out += "Every column, unrounded: sessions.csv.\n\n";
 
   // A uid on two hosts: said whenever the report spans hosts, so that "none" is a finding too.
@@ -114,7 +112,7 @@ std::string markdown_report(const ReportData& data) {
       for (const DuplicateUid& d : data.duplicates) {
         rows.push_back({markdown_escape(d.uid), escaped_list(d.hosts), escaped_list(d.folders)});
       }
-      table(out, {"uid", "hosts", "sessions"}, rows);
+      markdown_table(out, {"uid", "hosts", "sessions"}, rows);
     }
   }
 
@@ -124,7 +122,7 @@ std::string markdown_report(const ReportData& data) {
     for (const RepeatedFolder& r : data.repeats) {
       rows.push_back({markdown_escape(r.folder), markdown_escape(r.same_as), markdown_escape(r.why)});
     }
-    table(out, {"left out", "reported", "why the same"}, rows);
+    markdown_table(out, {"left out", "reported", "why the same"}, rows);
   }
 
   if (!data.exclusions.empty()) {
@@ -134,14 +132,14 @@ std::string markdown_report(const ReportData& data) {
            "(in\\_statistics 0), not in the overview or the measures.\n\n";
     rows.clear();
     for (const Exclusion& e : data.exclusions) rows.push_back({markdown_escape(e.reason), std::to_string(e.sessions)});
-    table(out, {"why", "sessions"}, rows);
+    markdown_table(out, {"why", "sessions"}, rows);
   }
 
   if (!data.skipped.empty()) {
     out += "## Skipped sessions\n\n";
     rows.clear();
     for (const SkippedSession& s : data.skipped) rows.push_back({markdown_escape(s.folder), markdown_escape(s.reason)});
-    table(out, {"folder", "reason"}, rows);
+    markdown_table(out, {"folder", "reason"}, rows);
   }
 
   if (!data.warnings.empty()) {

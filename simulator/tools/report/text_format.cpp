@@ -17,6 +17,8 @@ std::string format_fixed(double value, int decimals) {
   return out;
 }
 
+std::string optional_cell(const std::optional<double>& value) { return value ? format_fixed(*value, 3) : ""; }
+
 std::string format_number(double value, int decimals) {
   std::string out = format_fixed(value, decimals);
   if (out.find('.') != std::string::npos && std::isfinite(value)) {

@@ -3,6 +3,7 @@
 // escaped for the format it lands in (CSV, Markdown, HTML and SVG), so that data cannot change the markup.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -10,6 +11,9 @@ namespace rfbsim::report {
 
 /// `value` with `decimals` digits after the point ("%.*f"); "-0.000" comes out as "0.000".
 std::string format_fixed(double value, int decimals);
+
+/// An optional measure in a table cell: three decimals, or empty when there is none.
+std::string optional_cell(const std::optional<double>& value);
 
 /// `value` with up to `decimals` digits after the point, trailing zeros and a bare point dropped
 /// ("5", "0.25"): the compact form for CSV.

@@ -10,6 +10,7 @@
 #include "abuse_clients.hpp"
 #include "manager_process.hpp"
 #include "rfb_test_client.hpp"
+#include "skip.hpp"
 #include "ws_rfb_bridge.hpp"
 
 using namespace std::chrono_literals;
@@ -55,8 +56,8 @@ long retry_after(const rfbsim::test::net::HttpResponse& response) {
 void idle_flood(int count) {
   // This process holds every flood socket; the manager inherits the limit and sizes its total cap from it.
   if (!abuse::raise_descriptor_limit(static_cast<std::uint64_t>(count) + 512)) {
-    WARN("SKIPPED: the descriptor limit cannot be raised to " << count + 512);
-    return;
+    RFBSIM_SKIP("the descriptor limit cannot be raised to " + std::to_string(count + 512) +
+                " (ulimit -Hn; root may raise it)");
   }
   TempDir data;
   ManagerUnderTest manager(data.path(), with_small_sessions({}));
@@ -203,7 +204,7 @@ TEST_CASE("2000 idle connections from one address: only the per-address cap stay
 }
 
 TEST_CASE("slowloris connections are closed by the handshake timeout while another address is served",
-          "[manager][abuse]") {
+          "[manager][abuse][waits]") {
   TempDir data;
   ManagerUnderTest manager(data.path(), with_small_sessions({}));
   constexpr int kSlow = 20;

@@ -17,6 +17,7 @@
 #include "manager_process.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::kAdminToken;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::TempDir;
 using rfbsim::test::token_from_redirect;
@@ -25,7 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kAdminToken = "copy-admin-token-0123456789";
 constexpr const char* kHost = "copy-host";
 // sim_rfb refuses a goal off the map before it listens and exits with 2: a session that ends at once.
 constexpr const char* kFailingStart = "scenario=lab&robot_goal=500,500,0";
@@ -168,7 +168,7 @@ TEST_CASE("an ended session's folder is copied to the store, the same files, don
 }
 
 TEST_CASE("a copy that fails twice is tried again after its backoff and ends done after three tries",
-          "[manager][copy]") {
+          "[manager][copy][waits]") {
   TempDir data;
   TempDir store("rfbsim-copy-store");
   const fs::path runs = store.path() / "runs";
@@ -198,7 +198,7 @@ TEST_CASE("a copy that fails twice is tried again after its backoff and ends don
 }
 
 TEST_CASE("a copy that always fails ends failed with its words recorded, and the manager carries on",
-          "[manager][copy]") {
+          "[manager][copy][waits]") {
   TempDir data;
   TempDir store("rfbsim-copy-store");
   // Slow to fail, so that a session's process exits (and is reaped) while a copy runs.

@@ -86,7 +86,7 @@ TEST_CASE("at the descriptor limit the manager pauses accepting instead of spinn
 }
 
 TEST_CASE("a browser that stops reading costs the manager no memory, and other sessions keep streaming",
-          "[manager][faults]") {
+          "[manager][faults][waits]") {
   TempDir data;
   ManagerUnderTest manager(data.path(), with_small_sessions({}));
   const std::string slow_token = token_from_redirect(manager.start("uid=slow-reader"));
@@ -119,7 +119,7 @@ TEST_CASE("a browser that stops reading costs the manager no memory, and other s
 }
 
 TEST_CASE("a SIGSTOPped session does not stall the manager, and is still killed at its maximum duration",
-          "[manager][faults]") {
+          "[manager][faults][waits]") {
   TempDir data;
   ManagerUnderTest manager(data.path(), with_small_sessions({"--max-duration-s", "8", "--stop-grace-s", "2"}));
   const std::string frozen = streamed_session(manager, "frozen-1");  // seen: it ends expired, not abandoned

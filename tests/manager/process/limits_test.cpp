@@ -13,16 +13,16 @@
 #include "ws_rfb_bridge.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::kAdminToken;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::RfbTestClient;
 using rfbsim::test::TempDir;
-using rfbsim::test::WsRfbBridge;
 using rfbsim::test::token_from_redirect;
 using rfbsim::test::with_small_sessions;
+using rfbsim::test::WsRfbBridge;
 
 namespace {
 
-constexpr const char* kAdminToken = "test-admin-token-0123456789";
 
 }  // namespace
 
@@ -81,7 +81,7 @@ TEST_CASE("a session ends at its maximum duration and its browser is told so", "
   CHECK(late.last_handshake_status() == 410);
 }
 
-TEST_CASE("a session with no browser ends after the idle timeout, and not while one is connected", "[manager]") {
+TEST_CASE("a session with no browser ends after the idle timeout, and not while one is connected", "[manager][waits]") {
   TempDir data;
   ManagerUnderTest manager(data.path(), with_small_sessions({"--idle-timeout-s", "1"}));
 
@@ -210,7 +210,7 @@ void check_start_end_cycles(const int kCycles) {
 
 // A leak of one descriptor or process per cycle shows after a few dozen; the 200 run is the heavy version, on
 // demand with the floods (`ctest -L flood`), which keeps CI's run short.
-TEST_CASE("40 start/end cycles leave no process, descriptor or listening port behind", "[manager][cycles]") {
+TEST_CASE("40 start/end cycles leave no process, descriptor or listening port behind", "[manager][cycles][busy]") {
   check_start_end_cycles(40);
 }
 

@@ -18,7 +18,10 @@
 #include "ws_rfb_bridge.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::admin_post;
 using rfbsim::test::eventually;
+using rfbsim::test::free_loopback_port;
+using rfbsim::test::kAdminToken;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::RfbTestClient;
 using rfbsim::test::TempDir;
@@ -27,7 +30,6 @@ namespace net = rfbsim::test::net;
 
 namespace {
 
-constexpr const char* kAdminToken = "test-admin-token-0123456789";
 const std::vector<std::pair<std::string, std::string>> kAdmin = {{"Authorization", std::string("Bearer ") + kAdminToken}};
 
 std::vector<std::string> minimal_flags(std::vector<std::string> more) {
@@ -36,20 +38,6 @@ std::vector<std::string> minimal_flags(std::vector<std::string> more) {
                                     "--admin-token",  kAdminToken,   "--host-id",         "h2"};
   flags.insert(flags.end(), more.begin(), more.end());
   return rfbsim::test::without_abuse_limits(flags);
-}
-
-// A loopback port nobody listens on now (the agent's port must be given: 0 switches it off).
-int free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  REQUIRE(fd >= 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof address;
-  REQUIRE(::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0);
-  REQUIRE(::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0);
-  ::close(fd);
-  return ntohs(address.sin_port);
 }
 
 // What the agent on `port` says: everything it writes before it closes ("" when nothing answers).
@@ -69,13 +57,6 @@ std::string agent_line(int port) {
   }
   ::close(fd);
   return text;
-}
-
-// POST `path` with the admin token and, unless told not to, the admin header.
-net::HttpResponse admin_post(const ManagerUnderTest& manager, const std::string& path, bool admin_header = true) {
-  return net::http_request(manager.port(), "POST " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " +
-                                               kAdminToken + "\r\n" + (admin_header ? "X-Rfbsim-Admin: 1\r\n" : "") +
-                                               "Content-Length: 0\r\nConnection: close\r\n\r\n");
 }
 
 // The token of a 302 to `prefix`/s/<token>/ ("" for any other answer).
@@ -138,7 +119,7 @@ TEST_CASE("under a path prefix the link redirects into it, and the page, status 
 
 TEST_CASE("the agent port says how much room is left, and drain when full or drained", "[manager][cluster]") {
   TempDir data;
-  const int agent_port = free_port();
+  const int agent_port = free_loopback_port();
   ManagerUnderTest manager(data.path(),
                            minimal_flags({"--max-sessions", "2", "--agent-port", std::to_string(agent_port)}));
   CHECK(agent_line(agent_port) == "up ready 100%\n");

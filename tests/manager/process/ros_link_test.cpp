@@ -20,6 +20,7 @@
 #include "manager_process.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::kAdminToken;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::TempDir;
 using rfbsim::test::token_from_redirect;
@@ -28,7 +29,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kAdminToken = "ros-admin-token-0123456789";
 constexpr const char* kLinkSecret = "ros-link-secret-0123456789";
 
 // Writes `text` to `path` with `mode`.

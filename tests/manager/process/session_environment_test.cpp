@@ -20,6 +20,7 @@
 #include "sim_process.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::kAdminToken;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::TempDir;
 using rfbsim::test::token_from_redirect;
@@ -27,7 +28,6 @@ using rfbsim::test::with_small_sessions;
 
 namespace {
 
-constexpr const char* kAdminToken = "env-admin-token-0123456789";
 constexpr const char* kLinkSecret = "env-link-secret-0123456789";
 
 using rfbsim::test::ScopedEnv;

@@ -18,6 +18,7 @@
 #include "ws_rfb_bridge.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::kAdminToken;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::RfbTestClient;
 using rfbsim::test::TempDir;
@@ -27,7 +28,6 @@ using rfbsim::test::WsRfbBridge;
 
 namespace {
 
-constexpr const char* kAdminToken = "test-admin-token-0123456789";
 
 // The live session of `token` as /api/sessions shows it (null when it is not listed or the API fails).
 nlohmann::json live_session(const ManagerUnderTest& manager, const std::string& token) {

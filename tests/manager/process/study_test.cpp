@@ -24,7 +24,7 @@ using rfbsim::test::token_from_redirect;
 using rfbsim::test::with_small_sessions;
 
 TEST_CASE("a timed-out task reaches the page's status, the index and the session's data with the link's code",
-          "[manager][study]") {
+          "[manager][study][waits]") {
   TempDir data;
   ::setenv("RFBSIM_ADDRESS_KEY", "study-key-for-the-test", 1);  // inherited by the manager and its sessions
   ManagerUnderTest manager(data.path(), with_small_sessions({"--session-arg", "--time-limit", "--session-arg", "2"}));

@@ -30,6 +30,9 @@
 #include "ws_rfb_bridge.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::admin_post;
+using rfbsim::test::free_loopback_port;
+using rfbsim::test::kAdminToken;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::TempDir;
 namespace net = rfbsim::test::net;
@@ -37,7 +40,6 @@ namespace net = rfbsim::test::net;
 namespace {
 
 const std::string kSecret = "registry-test-secret-0123456789";
-const std::string kAdminToken = "registry-admin-token-0123";
 
 // Lower-case hex HMAC-SHA256, written here again so that the test does not trust the manager's own.
 std::string hmac_hex(const std::string& secret, const std::string& text) {
@@ -71,19 +73,6 @@ long long unix_now() {
   return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-// A loopback port that was free a moment ago.
-int free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof address;
-  REQUIRE(::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0);
-  REQUIRE(::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0);
-  ::close(fd);
-  return ntohs(address.sin_port);
-}
-
 // Sends `text` to 127.0.0.1:`port` and returns everything read until the peer closes (or 5 s pass).
 std::string ask_registry(int port, const std::string& text) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
@@ -114,7 +103,7 @@ class Cluster {
     ::chmod(secret_file_.c_str(), 0600);
     std::string peers;
     for (int i = 0; i < count_; ++i) {
-      registry_ports_.push_back(free_port());
+      registry_ports_.push_back(free_loopback_port());
       peer_lines_.push_back(id(i) + "=127.0.0.1:" + std::to_string(registry_ports_.back()));
       peers += (i == 0 ? "" : ",") + peer_lines_.back();
     }
@@ -209,13 +198,6 @@ std::string token_of(const net::HttpResponse& response, const std::string& host_
   const std::string prefix = "/" + host_id + "/s/";
   if (location.rfind(prefix, 0) != 0 || location.size() != prefix.size() + 33) return "";
   return location.substr(prefix.size(), 32);
-}
-
-// A POST to the admin API, with the admin token and header.
-net::HttpResponse admin_post(const ManagerUnderTest& manager, const std::string& path) {
-  return net::http_request(manager.port(), "POST " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " +
-                                               kAdminToken + "\r\nX-Rfbsim-Admin: 1\r\nContent-Length: 0\r\n" +
-                                               "Connection: close\r\n\r\n");
 }
 
 }  // namespace

@@ -16,10 +16,12 @@
 
 #include "manager_process.hpp"
 #include "rfb_test_client.hpp"
+#include "skip.hpp"
 #include "ws_rfb_bridge.hpp"
 
 using namespace std::chrono_literals;
 using rfbsim::test::eventually;
+using rfbsim::test::kAdminToken;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::RfbTestClient;
 using rfbsim::test::TempDir;
@@ -30,7 +32,6 @@ using rfbsim::test::WsRfbBridgeOptions;
 
 namespace {
 
-constexpr const char* kAdminToken = "test-admin-token-0123456789";
 const std::string kBearer = std::string("Bearer ") + kAdminToken;
 const char* const kStdbuf = "/usr/bin/stdbuf";
 
@@ -112,10 +113,7 @@ int send_raw(int port, const std::string& bytes) {
 }  // namespace
 
 TEST_CASE("a watcher sees the session, but its keys and clicks never reach it", "[manager][watch]") {
-  if (!std::filesystem::exists(kStdbuf)) {
-    WARN("skipped: " << kStdbuf << " is missing");
-    return;
-  }
+  if (!std::filesystem::exists(kStdbuf)) RFBSIM_SKIP(std::string(kStdbuf) + " is missing (Debian's coreutils)");
   TempDir data;
   ManagerUnderTest manager(data.path(), minimal_session_flags());
   const std::string token = token_from_redirect(manager.start("uid=watch-1"));
@@ -302,7 +300,7 @@ TEST_CASE("a session with only a watcher connected still ends as idle", "[manage
   CHECK(row->detail == "no browser connected for 1 s");
 }
 
-TEST_CASE("a researcher watching first does not start the participant's task clock; the participant does",
+TEST_CASE("a researcher watching first does not start the participant's task clock, and the participant does",
           "[manager][watch][study]") {
   TempDir data;
   ManagerUnderTest manager(data.path(),

@@ -22,17 +22,17 @@
 #include "x11_display_check.hpp"
 
 using namespace std::chrono_literals;
+using rfbsim::test::display_left_behind;
+using rfbsim::test::file_text;
+using rfbsim::test::kAdminToken;
 using rfbsim::test::ManagerUnderTest;
 using rfbsim::test::RfbTestClient;
 using rfbsim::test::TempDir;
-using rfbsim::test::WsRfbBridge;
-using rfbsim::test::display_left_behind;
-using rfbsim::test::file_text;
 using rfbsim::test::token_from_redirect;
+using rfbsim::test::WsRfbBridge;
 
 namespace {
 
-constexpr const char* kAdminToken = "test-admin-token-0123456789";
 std::vector<std::string> x11_flags(std::vector<std::string> extra = {}) {
   std::vector<std::string> flags = {"--session-kind",  "x11",       "--session-command", RFBSIM_X11_KEY_ECHO,
                                     "--x11-geometry",  "320x240",   "--admin-token",     kAdminToken,

@@ -57,12 +57,19 @@ TEST_CASE("X-Forwarded-For counts only from a trusted peer") {
   CHECK(client_address("10.0.0.5", "", trusted) == "10.0.0.5");
 }
 
-TEST_CASE("the rightmost untrusted entry is the client; made-up entries to its left are ignored") {
+TEST_CASE("the rightmost untrusted entry is the client, and made-up entries to its left are ignored") {
   const auto trusted = ranges({"10.0.0.0/8"});
   CHECK(client_address("10.0.0.5", "1.2.3.4, 203.0.113.9", trusted) == "203.0.113.9");
   CHECK(client_address("10.0.0.5", "1.2.3.4, 203.0.113.9, 10.0.0.9", trusted) == "203.0.113.9");
-  // Garbage stops the walk at the last address believed.
+}
+
+TEST_CASE("garbage in X-Forwarded-For stops the walk at the last address believed") {
+  const auto trusted = ranges({"10.0.0.0/8"});
   CHECK(client_address("10.0.0.5", "203.0.113.9, not-an-address", trusted) == "10.0.0.5");
+}
+
+TEST_CASE("a trusted peer in IPv4-mapped form is trusted, and an IPv6 entry with spaces around is the client") {
+  const auto trusted = ranges({"10.0.0.0/8"});
   CHECK(client_address("::ffff:10.0.0.5", " 2001:db8::7 ", trusted) == "2001:db8::7");
 }
 

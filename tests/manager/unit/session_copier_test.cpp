@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "eventually.hpp"
 #include "scratch_dir.hpp"
 #include "session_copier.hpp"
 #include "session_index.hpp"
@@ -28,6 +29,7 @@ using rfbsim::manager::Session;
 using rfbsim::manager::SessionCopier;
 using rfbsim::manager::SessionIndex;
 using rfbsim::manager::SessionState;
+using rfbsim::test::eventually;
 using rfbsim::test::ScratchDir;
 using namespace std::chrono_literals;
 
@@ -73,15 +75,6 @@ struct Outcomes {
     };
   }
 };
-
-bool eventually(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
-  const auto until = std::chrono::steady_clock::now() + timeout;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > until) return false;
-    std::this_thread::sleep_for(10ms);
-  }
-  return true;
-}
 
 }  // namespace
 

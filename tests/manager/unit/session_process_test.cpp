@@ -390,6 +390,11 @@ SpawnSpec in_folder(const std::string& folder) {
 
 using rfbsim::test::ScopedEnv;
 
+// A manager's environment with PATH, DISPLAY and LD_LIBRARY_PATH (neither allow-listed) and FOO.
+std::vector<EnvVar> spec_env_manager_variables() {
+  return {{"PATH", "/usr/bin"}, {"DISPLAY", ":0"}, {"LD_LIBRARY_PATH", "/opt/lib"}, {"FOO", "bar"}};
+}
+
 }  // namespace
 
 TEST_CASE("a session's environment is the allow-listed part of the manager's, with HOME its folder") {
@@ -410,13 +415,25 @@ TEST_CASE("a session without the manager's PATH gets a usual one") {
   CHECK(session_environment({}, in_folder("")) == Strings{"PATH=/usr/local/bin:/usr/bin:/bin"});
 }
 
-TEST_CASE("the spec's variables are added and replace inherited ones; its extra names are passed on") {
+TEST_CASE("the spec's variables are added and replace inherited ones") {
+  SpawnSpec spec = in_folder("/d");
+  spec.env = {{"DISPLAY", ":1"}, {"XAUTHORITY", "/d/.Xauthority"}, {"PATH", "/bin"}, {"HOME", "/srv/x11"}};
+  CHECK(session_environment(spec_env_manager_variables(), spec) ==
+        Strings{"DISPLAY=:1", "XAUTHORITY=/d/.Xauthority", "PATH=/bin", "HOME=/srv/x11"});
+}
+
+TEST_CASE("the spec's extra names are passed on from the manager's environment") {
+  SpawnSpec spec = in_folder("/d");
+  spec.pass_env = {"LD_LIBRARY_PATH", "ABSENT"};
+  CHECK(session_environment(spec_env_manager_variables(), spec) ==
+        Strings{"PATH=/usr/bin", "LD_LIBRARY_PATH=/opt/lib", "HOME=/d"});
+}
+
+TEST_CASE("the spec's extra names come before its variables") {
   SpawnSpec spec = in_folder("/d");
   spec.env = {{"DISPLAY", ":1"}, {"XAUTHORITY", "/d/.Xauthority"}, {"PATH", "/bin"}, {"HOME", "/srv/x11"}};
   spec.pass_env = {"LD_LIBRARY_PATH", "ABSENT"};
-  const std::vector<EnvVar> manager = {{"PATH", "/usr/bin"}, {"DISPLAY", ":0"}, {"LD_LIBRARY_PATH", "/opt/lib"},
-                                       {"FOO", "bar"}};
-  CHECK(session_environment(manager, spec) ==
+  CHECK(session_environment(spec_env_manager_variables(), spec) ==
         Strings{"LD_LIBRARY_PATH=/opt/lib", "DISPLAY=:1", "XAUTHORITY=/d/.Xauthority", "PATH=/bin", "HOME=/srv/x11"});
 }
 

@@ -8,12 +8,14 @@
 #include <memory>
 #include <thread>
 
+#include "eventually.hpp"
 #include "lab_server.hpp"
 #include "ros/bridge/rosbridge_client.hpp"
 #include "scratch_dir.hpp"
 #include "tls_test_cert.hpp"
 
 using namespace rfbsim::ros;
+using rfbsim::test::eventually;
 using rfbsim::test::LabServer;
 using rfbsim::test::LabServerOptions;
 using std::chrono::milliseconds;
@@ -21,17 +23,7 @@ using std::chrono::seconds;
 
 namespace {
 
-template <typename Done>
-bool eventually(Done done, milliseconds limit = seconds(15)) {
-  const auto deadline = std::chrono::steady_clock::now() + limit;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(milliseconds(5));
-  }
-  return true;
-}
-
-void declare_topics(RosbridgeHub& hub) {
+void declare_lab_topics(RosbridgeHub& hub) {
   hub.declare("/map", "nav_msgs/msg/OccupancyGrid", true);
   hub.declare("/odom", "nav_msgs/msg/Odometry", false);
   hub.accept("/cmd_vel", {"geometry_msgs/msg/Twist", "geometry_msgs/msg/TwistStamped"});
@@ -71,7 +63,7 @@ std::vector<IncomingMessage> wait_incoming(RosbridgeHub& hub) {
 
 TEST_CASE("the client sends its token, advertises and subscribes, and carries publishes both ways") {
   RosbridgeHub hub("/rfbsim/s1");
-  declare_topics(hub);
+  declare_lab_topics(hub);
   hub.publish("/map", {{"width", 2}});
   LabServer lab;
   RosbridgeClientOptions options;
@@ -109,7 +101,7 @@ TEST_CASE("the client sends its token, advertises and subscribes, and carries pu
 
 TEST_CASE("the client reconnects after the server restarts and greets it again") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_lab_topics(hub);
   hub.publish("/map", {{"width", 5}});
   auto lab = std::make_unique<LabServer>();
   const int port = lab->port();
@@ -145,7 +137,7 @@ TEST_CASE("wss: the client verifies the server's certificate through ca_file") {
   const rfbsim::test::TestCertificate certificate = rfbsim::test::make_test_certificate(dir.path());
   LabServer lab(LabServerOptions{0, certificate.cert_pem.string(), certificate.key_pem.string()});
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_lab_topics(hub);
 
   SECTION("trusted through ca_file: connects and works") {
     RosbridgeClientOptions options;
@@ -202,7 +194,7 @@ TEST_CASE("the client refuses bad options at construction, naming them") {
 
 TEST_CASE("a client whose server is down keeps retrying quietly and stops at once when destroyed") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_lab_topics(hub);
   int port = 0;
   {
     LabServer probe;  // a port that was free a moment ago, now closed
@@ -219,7 +211,7 @@ TEST_CASE("a client whose server is down keeps retrying quietly and stops at onc
 
 TEST_CASE("the client pings, and drops and redials a link whose server stops answering") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_lab_topics(hub);
   LabServer lab;
   RosbridgeClientOptions options;
   options.url = "ws://127.0.0.1:" + std::to_string(lab.port());
@@ -238,7 +230,7 @@ TEST_CASE("the client pings, and drops and redials a link whose server stops ans
 
 TEST_CASE("statuses for the dial-out link stay local: the lab's server takes no status op") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_lab_topics(hub);
   LabServer lab;
   RosbridgeClient client(hub, plain_options(lab.port()));
   REQUIRE(eventually([&] { return client.connected() && lab.received().size() >= 3; }));
@@ -250,7 +242,7 @@ TEST_CASE("statuses for the dial-out link stay local: the lab's server takes no 
 
 TEST_CASE("the client sends what the hub still holds before it closes") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_lab_topics(hub);
   LabServer lab;
   auto client = std::make_unique<RosbridgeClient>(hub, plain_options(lab.port()));
   REQUIRE(eventually([&] { return client->connected() && lab.received().size() >= 3; }));

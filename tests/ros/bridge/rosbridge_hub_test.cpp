@@ -28,6 +28,14 @@ std::vector<nlohmann::json> drain(RosbridgeHub& hub, int connection) {
 
 nlohmann::json counter(int n) { return {{"data", n}}; }
 
+// Nine topics, /t0 to /t8: more than the 256 subscriptions a connection may hold, at 32 per topic.
+void declare_capped_topics(RosbridgeHub& hub) {
+  for (int t = 0; t < 9; ++t) hub.declare("/t" + std::to_string(t), "std_msgs/Int32", false);
+}
+
+// Subscription id "id`n`", with no throttle and no queue length.
+SubscribeOptions capped_id(int n) { return SubscribeOptions{"id" + std::to_string(n), 0, 0}; }
+
 }  // namespace
 
 TEST_CASE("declare and accept check their names and types") {
@@ -275,34 +283,55 @@ TEST_CASE("a status text is cut to the hub's bound, never inside a UTF-8 charact
   CHECK(frames[2]["msg"] == "short");
 }
 
-TEST_CASE("subscription ids are capped per topic and per connection; a refused one changes nothing") {
+TEST_CASE("subscription ids are capped per topic, and the same id again only replaces its options") {
   RosbridgeHub hub;
-  for (int t = 0; t < 9; ++t) hub.declare("/t" + std::to_string(t), "std_msgs/Int32", false);
+  declare_capped_topics(hub);
   const int connection = hub.open_connection({});
-  const auto id = [](int n) { return SubscribeOptions{"id" + std::to_string(n), 0, 0}; };
-
   // 32 ids on one topic; the 33rd is refused, the same id again only replaces its options.
-  for (int n = 0; n < 32; ++n) CHECK(hub.subscribe(connection, "/t0", id(n)).empty());
-  const std::string refused = hub.subscribe(connection, "/t0", id(32));
-  CHECK(refused.find("32 subscriptions to this topic") != std::string::npos);
+  for (int n = 0; n < 32; ++n) CHECK(hub.subscribe(connection, "/t0", capped_id(n)).empty());
+  CHECK(hub.subscribe(connection, "/t0", capped_id(32)).find("32 subscriptions to this topic") != std::string::npos);
   CHECK(hub.subscribe(connection, "/t0", SubscribeOptions{"id5", 100, 3}).empty());
-  CHECK_FALSE(hub.unsubscribe(connection, "/t0", "id32"));  // never added
+}
 
+TEST_CASE("subscription ids are capped per connection, and unsubscribing frees room") {
+  RosbridgeHub hub;
+  declare_capped_topics(hub);
+  const int connection = hub.open_connection({});
   // 256 on the connection: 8 topics of 32, then even a first one on a ninth topic is refused.
-  for (int t = 1; t < 8; ++t) {
-    for (int n = 0; n < 32; ++n) CHECK(hub.subscribe(connection, "/t" + std::to_string(t), id(n)).empty());
+  for (int t = 0; t < 8; ++t) {
+    for (int n = 0; n < 32; ++n) CHECK(hub.subscribe(connection, "/t" + std::to_string(t), capped_id(n)).empty());
   }
-  CHECK(hub.subscribe(connection, "/t8", id(0)).find("256 subscriptions on this connection") != std::string::npos);
-  CHECK_FALSE(hub.wanted("/t8"));
+  CHECK(hub.subscribe(connection, "/t8", capped_id(0)).find("256 subscriptions on this connection") !=
+        std::string::npos);
 
   // Unsubscribing frees room: one id, or a whole topic.
   CHECK(hub.unsubscribe(connection, "/t1", "id0"));
-  CHECK(hub.subscribe(connection, "/t8", id(0)).empty());
-  CHECK_FALSE(hub.subscribe(connection, "/t8", id(1)).empty());
+  CHECK(hub.subscribe(connection, "/t8", capped_id(0)).empty());
+  CHECK_FALSE(hub.subscribe(connection, "/t8", capped_id(1)).empty());
   CHECK(hub.unsubscribe(connection, "/t2", ""));
-  for (int n = 1; n < 33; ++n) CHECK(hub.subscribe(connection, "/t8", id(n)).size() == (n < 32 ? 0u : refused.size()));
+  for (int n = 1; n < 32; ++n) CHECK(hub.subscribe(connection, "/t8", capped_id(n)).empty());
+  // The 33rd on /t8 meets the topic's cap now, not the connection's.
+  CHECK(hub.subscribe(connection, "/t8", capped_id(32)).find("32 subscriptions to this topic") != std::string::npos);
   hub.publish("/t8", counter(1));
   CHECK(drain(hub, connection).size() == 1);  // one merged subscription, one frame
+}
+
+TEST_CASE("a refused subscription changes nothing") {
+  RosbridgeHub hub;
+  declare_capped_topics(hub);
+  const int connection = hub.open_connection({});
+  // Refused by the topic's cap: the id was never added.
+  for (int n = 0; n < 32; ++n) REQUIRE(hub.subscribe(connection, "/t0", capped_id(n)).empty());
+  REQUIRE_FALSE(hub.subscribe(connection, "/t0", capped_id(32)).empty());
+  CHECK_FALSE(hub.unsubscribe(connection, "/t0", "id32"));  // never added
+  // Refused by the connection's cap: the topic is not wanted, and a publish to it reaches nobody.
+  for (int t = 1; t < 8; ++t) {
+    for (int n = 0; n < 32; ++n) REQUIRE(hub.subscribe(connection, "/t" + std::to_string(t), capped_id(n)).empty());
+  }
+  REQUIRE_FALSE(hub.subscribe(connection, "/t8", capped_id(0)).empty());
+  CHECK_FALSE(hub.wanted("/t8"));
+  hub.publish("/t8", counter(1));
+  CHECK(drain(hub, connection).empty());
 }
 
 TEST_CASE("statuses for a dial-out link go to its local_status, never on the wire") {

@@ -14,31 +14,22 @@
 #include <thread>
 #include <vector>
 
+#include "eventually.hpp"
 #include "ros/bridge/rosbridge_server.hpp"
 #include "test_ws_client.hpp"
 
 using namespace rfbsim::ros;
+using rfbsim::test::eventually;
 using rfbsim::test::TestWsClient;
 using std::chrono::milliseconds;
 using std::chrono::seconds;
 
 namespace {
 
-void declare_topics(RosbridgeHub& hub) {
+void declare_served_topics(RosbridgeHub& hub) {
   hub.declare("/scan", "sensor_msgs/msg/LaserScan", false);
   hub.declare("/map", "nav_msgs/msg/OccupancyGrid", true);
   hub.accept("/cmd_vel", {"geometry_msgs/msg/Twist", "geometry_msgs/msg/TwistStamped"});
-}
-
-// Waits until `done()` holds, checking every 5 ms; false after `limit` (a failure bound, not a timing check).
-template <typename Done>
-bool eventually(Done done, milliseconds limit = seconds(10)) {
-  const auto deadline = std::chrono::steady_clock::now() + limit;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(milliseconds(5));
-  }
-  return true;
 }
 
 // A TCP connection to 127.0.0.1:`port` that sends nothing (a half-open WebSocket); -1 when refused.
@@ -70,11 +61,35 @@ void subscribe(TestWsClient& client, const std::string& topic) {
   client.send_json({{"op", "set_level"}, {"level", "warning"}});
 }
 
+// Server options with a message limit of 1000 bytes.
+RosbridgeServerOptions oversize_limited_options() {
+  RosbridgeServerOptions options;
+  options.max_message_bytes = 1000;
+  return options;
+}
+
+// Sends `client` a publish of about 2 KB (over oversize_limited_options' limit) and reads on to the close
+// frame; the first status it got, if any.
+std::optional<nlohmann::json> send_oversized_publish(TestWsClient& client) {
+  const std::string big = R"({"op":"publish","topic":"/cmd_vel","msg":{"pad":")" + std::string(2000, 'x') + "\"}}";
+  client.send(big);
+  const auto status = client.wait_for(op_is("status"));
+  while (client.read_frame(seconds(5))) {}  // to the close frame
+  return status;
+}
+
+// Sends `client` a 20 KB message, far over oversize_limited_options' limit, and reads on to the close frame.
+void send_far_oversized(TestWsClient& client) {
+  // Far over the limit: websocketpp refuses it itself while reading, with the same close code.
+  client.send(std::string(20'000, ' '));
+  while (client.read_frame(seconds(5))) {}
+}
+
 }  // namespace
 
 TEST_CASE("a subscriber gets the simulation's publishes and a publish to /cmd_vel reaches the simulation") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_served_topics(hub);
   hub.publish("/map", {{"info", {{"width", 4}}}});
   RosbridgeServer server(hub, {});
   REQUIRE(server.port() > 0);
@@ -111,7 +126,7 @@ TEST_CASE("a subscriber gets the simulation's publishes and a publish to /cmd_ve
 
 TEST_CASE("bad input gets an error status and the connection stays open") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_served_topics(hub);
   RosbridgeServer server(hub, {});
   TestWsClient client(server.port());
   const auto error_with_id = [](const std::string& id) {
@@ -138,31 +153,45 @@ TEST_CASE("bad input gets an error status and the connection stays open") {
   CHECK(client.wait_for(op_is("publish")));
 }
 
-TEST_CASE("an oversized message gets an error status and a close with 1009; a second client is served") {
+TEST_CASE("an oversized message gets an error status and a close with 1009") {
   RosbridgeHub hub;
-  declare_topics(hub);
-  RosbridgeServerOptions options;
-  options.max_message_bytes = 1000;
-  RosbridgeServer server(hub, options);
-  {
-    TestWsClient client(server.port());
-    const std::string big = R"({"op":"publish","topic":"/cmd_vel","msg":{"pad":")" + std::string(2000, 'x') + "\"}}";
-    client.send(big);
-    const auto status = client.wait_for(op_is("status"));
-    REQUIRE(status);
-    CHECK((*status)["level"] == "error");
-    CHECK((*status)["msg"].get<std::string>().find("over the limit") != std::string::npos);
-    while (client.read_frame(seconds(5))) {}  // to the close frame
-    CHECK(client.close_code() == 1009);
-  }
-  {
-    // Far over the limit: websocketpp refuses it itself while reading, with the same close code.
-    TestWsClient client(server.port());
-    client.send(std::string(20'000, ' '));
-    while (client.read_frame(seconds(5))) {}
-    CHECK(client.close_code() == 1009);
-  }
+  declare_served_topics(hub);
+  RosbridgeServer server(hub, oversize_limited_options());
+  TestWsClient client(server.port());
+  const auto status = send_oversized_publish(client);
+  REQUIRE(status);
+  CHECK((*status)["level"] == "error");
+  CHECK((*status)["msg"].get<std::string>().find("over the limit") != std::string::npos);
+  CHECK(client.close_code() == 1009);
   CHECK(hub.take_incoming().empty());
+  CHECK(eventually([&] { return server.stats().closed_oversized == 1; }));
+}
+
+TEST_CASE("a message far over the limit is refused while it is read, with a close with 1009") {
+  RosbridgeHub hub;
+  declare_served_topics(hub);
+  RosbridgeServer server(hub, oversize_limited_options());
+  TestWsClient client(server.port());
+  send_far_oversized(client);
+  CHECK(client.close_code() == 1009);
+  CHECK(hub.take_incoming().empty());
+  CHECK(server.stats().closed_oversized == 0);  // websocketpp's refusal: the server never saw the message
+}
+
+TEST_CASE("after oversized messages closed their clients, a second client is served") {
+  RosbridgeHub hub;
+  declare_served_topics(hub);
+  RosbridgeServer server(hub, oversize_limited_options());
+  {
+    TestWsClient client(server.port());
+    REQUIRE(send_oversized_publish(client));
+    REQUIRE(client.close_code() == 1009);
+  }
+  {
+    TestWsClient client(server.port());
+    send_far_oversized(client);
+    REQUIRE(client.close_code() == 1009);
+  }
   TestWsClient second(server.port());
   subscribe(second, "/scan");
   hub.publish("/scan", {{"ranges", {1.0}}});
@@ -172,7 +201,7 @@ TEST_CASE("an oversized message gets an error status and a close with 1009; a se
 
 TEST_CASE("the WebSocket is at / only, and connections beyond the limit are refused") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_served_topics(hub);
   RosbridgeServerOptions options;
   options.max_connections = 2;
   RosbridgeServer server(hub, options);
@@ -192,7 +221,7 @@ TEST_CASE("the WebSocket is at / only, and connections beyond the limit are refu
 
 TEST_CASE("a client that never reads loses its oldest messages, not the server's memory") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_served_topics(hub);
   RosbridgeServerOptions options;
   options.max_queued_bytes_per_connection = 64 << 10;
   RosbridgeServer server(hub, options);
@@ -217,7 +246,7 @@ TEST_CASE("a client that never reads loses its oldest messages, not the server's
 
 TEST_CASE("the server stops cleanly with clients connected and forgets its hub connections") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_served_topics(hub);
   auto server = std::make_unique<RosbridgeServer>(hub, RosbridgeServerOptions{});
   TestWsClient client(server->port());
   subscribe(client, "/scan");
@@ -231,7 +260,7 @@ TEST_CASE("the server stops cleanly with clients connected and forgets its hub c
 
 TEST_CASE("accepted sockets that never finish a handshake are capped at 4 x max_connections") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_served_topics(hub);
   RosbridgeServerOptions options;
   options.max_connections = 2;
   RosbridgeServer server(hub, options);
@@ -247,7 +276,7 @@ TEST_CASE("accepted sockets that never finish a handshake are capped at 4 x max_
 
 TEST_CASE("the server hands each client what the hub still holds before it closes") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_served_topics(hub);
   auto server = std::make_unique<RosbridgeServer>(hub, RosbridgeServerOptions{});
   TestWsClient client(server->port());
   subscribe(client, "/scan");
@@ -269,7 +298,7 @@ TEST_CASE("the server hands each client what the hub still holds before it close
 
 TEST_CASE("the oversized-message status overtakes a backlog and comes before the 1009 close") {
   RosbridgeHub hub;
-  declare_topics(hub);
+  declare_served_topics(hub);
   RosbridgeServerOptions options;
   options.max_message_bytes = 1000;
   RosbridgeServer server(hub, options);

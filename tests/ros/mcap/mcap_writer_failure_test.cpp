@@ -36,25 +36,14 @@ std::string error_of(F make) {
   return "";
 }
 
-}  // namespace
+// What a child that writes a bag of 200 messages to `path` under a 4 KiB file size limit reports: its wait
+// status and its text (the bag's failure, then "wrote all 200" once its loop and finish() returned).
+struct FullDiskRun {
+  int status = 0;
+  std::string report;
+};
 
-TEST_CASE("a bag is never written over an existing file, nor into a missing folder") {
-  ScratchDir dir("rfbsim_mcap");
-  const std::string existing = dir.write("session.mcap", "earlier data");
-  const std::string exists_error = error_of([&] { McapWriter bag(existing); });
-  CHECK(exists_error.find(existing) != std::string::npos);
-  CHECK(exists_error.find("File exists") != std::string::npos);
-  CHECK(dir.read("session.mcap") == "earlier data");
-
-  const std::string missing = dir.path("no/such/folder/session.mcap");
-  const std::string missing_error = error_of([&] { McapWriter bag(missing); });
-  CHECK(missing_error.find(missing) != std::string::npos);
-  CHECK(missing_error.find("No such file or directory") != std::string::npos);
-}
-
-TEST_CASE("a disk that fills stops the bag with a clear failure; the caller goes on; whole chunks stay") {
-  ScratchDir dir("rfbsim_mcap");
-  const std::string path = dir.path("session.mcap");
+FullDiskRun write_bag_until_disk_full(const std::string& path) {
   int pipe_fds[2];
   REQUIRE(::pipe(pipe_fds) == 0);
   const pid_t child = ::fork();
@@ -91,12 +80,48 @@ TEST_CASE("a disk that fills stops the bag with a clear failure; the caller goes
   ::close(pipe_fds[0]);
   int status = 0;
   REQUIRE(::waitpid(child, &status, 0) == child);
-  REQUIRE(WIFEXITED(status));
-  CHECK(WEXITSTATUS(status) == 0);
-  INFO(report);
-  CHECK(report.find("session.mcap: write failed at byte ") == 0);
-  CHECK(report.find("File too large") != std::string::npos);
-  CHECK(report.find("wrote all 200") != std::string::npos);
+  return {status, report};
+}
+
+}  // namespace
+
+TEST_CASE("a bag is never written over an existing file, nor into a missing folder") {
+  ScratchDir dir("rfbsim_mcap");
+  const std::string existing = dir.write("session.mcap", "earlier data");
+  const std::string exists_error = error_of([&] { McapWriter bag(existing); });
+  CHECK(exists_error.find(existing) != std::string::npos);
+  CHECK(exists_error.find("File exists") != std::string::npos);
+  CHECK(dir.read("session.mcap") == "earlier data");
+
+  const std::string missing = dir.path("no/such/folder/session.mcap");
+  const std::string missing_error = error_of([&] { McapWriter bag(missing); });
+  CHECK(missing_error.find(missing) != std::string::npos);
+  CHECK(missing_error.find("No such file or directory") != std::string::npos);
+}
+
+TEST_CASE("a disk that fills stops the bag with a clear failure") {
+  ScratchDir dir("rfbsim_mcap");
+  const FullDiskRun run = write_bag_until_disk_full(dir.path("session.mcap"));
+  INFO(run.report);
+  CHECK(run.report.find("session.mcap: write failed at byte ") == 0);
+  CHECK(run.report.find("File too large") != std::string::npos);
+}
+
+TEST_CASE("when the disk fills under a bag, the caller goes on") {
+  ScratchDir dir("rfbsim_mcap");
+  const FullDiskRun run = write_bag_until_disk_full(dir.path("session.mcap"));
+  INFO(run.report);
+  REQUIRE(WIFEXITED(run.status));
+  CHECK(WEXITSTATUS(run.status) == 0);
+  CHECK(run.report.find("wrote all 200") != std::string::npos);
+}
+
+TEST_CASE("when the disk fills under a bag, the whole chunks written before stay readable") {
+  ScratchDir dir("rfbsim_mcap");
+  const std::string path = dir.path("session.mcap");
+  const FullDiskRun run = write_bag_until_disk_full(path);
+  INFO(run.report);
+  REQUIRE(WIFEXITED(run.status));
 
   // The file is cut at the limit: every whole chunk in it opens with a good CRC, and the tail is torn.
   const Bytes file = read_file(path);

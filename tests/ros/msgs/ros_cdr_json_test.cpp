@@ -35,6 +35,13 @@ std::vector<std::string> keys(const json& object) {
   return out;
 }
 
+// A TwistStamped as rosbridge JSON: 0.2 m/s ahead, turning at 0.4 rad/s.
+json stamped_twist_json() {
+  return json::parse(
+      R"({"header": {"stamp": {"sec": 1, "nanosec": 2}, "frame_id": "base_link"},
+          "twist": {"linear": {"x": 0.2, "y": 0, "z": 0}, "angular": {"x": 0, "y": 0, "z": 0.4}}})");
+}
+
 }  // namespace
 
 TEST_CASE("ros msgs: CDR of a Clock, a String and a Twist, byte for byte", "[ros]") {
@@ -146,28 +153,42 @@ TEST_CASE("ros msgs: JSON of an OccupancyGrid, People and a Marker", "[ros]") {
   CHECK(m["markers"][0]["lifetime"] == json::parse(R"({"sec": 0, "nanosec": 0})"));
 }
 
-TEST_CASE("ros msgs: a Twist or TwistStamped from JSON; missing fields are 0", "[ros]") {
+TEST_CASE("ros msgs: a Twist from JSON", "[ros]") {
+  std::string error;
+  const auto twist = ros::twist_from_json(json::parse(R"({"linear": {"x": 0.3}, "angular": {"z": -1}})"),
+                                          "geometry_msgs/msg/Twist", error);
+  REQUIRE(twist);
+  CHECK(twist->linear.x == 0.3);
+  CHECK(twist->angular.z == -1.0);
+}
+
+TEST_CASE("ros msgs: fields missing from a Twist in JSON are 0", "[ros]") {
   std::string error;
   auto twist = ros::twist_from_json(json::parse(R"({"linear": {"x": 0.3}, "angular": {"z": -1}})"),
                                     "geometry_msgs/msg/Twist", error);
   REQUIRE(twist);
-  CHECK(twist->linear.x == 0.3);
   CHECK(twist->linear.y == 0.0);
-  CHECK(twist->angular.z == -1.0);
+  CHECK(twist->linear.z == 0.0);
+  CHECK(twist->angular.x == 0.0);
+  CHECK(twist->angular.y == 0.0);
 
   twist = ros::twist_from_json(json::object(), "geometry_msgs/Twist", error);
   REQUIRE(twist);
   CHECK(twist->linear.x == 0.0);
+  CHECK(twist->angular.z == 0.0);
+}
 
-  const json stamped = json::parse(
-      R"({"header": {"stamp": {"sec": 1, "nanosec": 2}, "frame_id": "base_link"},
-          "twist": {"linear": {"x": 0.2, "y": 0, "z": 0}, "angular": {"x": 0, "y": 0, "z": 0.4}}})");
-  twist = ros::twist_from_json(stamped, "geometry_msgs/msg/TwistStamped", error);
+TEST_CASE("ros msgs: a TwistStamped from JSON", "[ros]") {
+  std::string error;
+  const auto twist = ros::twist_from_json(stamped_twist_json(), "geometry_msgs/msg/TwistStamped", error);
   REQUIRE(twist);
   CHECK(twist->linear.x == 0.2);
   CHECK(twist->angular.z == 0.4);
-  // Without a type the "twist" key tells them apart.
-  twist = ros::twist_from_json(stamped, "", error);
+}
+
+TEST_CASE("ros msgs: without a type, the \"twist\" key tells a TwistStamped from a Twist", "[ros]") {
+  std::string error;
+  auto twist = ros::twist_from_json(stamped_twist_json(), "", error);
   REQUIRE(twist);
   CHECK(twist->angular.z == 0.4);
   twist = ros::twist_from_json(json::parse(R"({"linear": {"x": 1}})"), "", error);

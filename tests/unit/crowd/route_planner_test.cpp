@@ -36,6 +36,11 @@ void check_legs_clear(const RoutePlanner& planner, const Eigen::Vector2d& from, 
   }
 }
 
+// 5.5 m x 2.5 m at 0.5 m: two rooms with no way between them, split by a wall along column 4.
+GridMap two_closed_rooms_map() {
+  return grid_from_text({"###########", "#...#.....#", "#...#.....#", "#...#.....#", "###########"}, 0.5);
+}
+
 }  // namespace
 
 TEST_CASE("in an open room the route is the goal itself") {
@@ -82,11 +87,13 @@ TEST_CASE("a gap narrower than the clearance is still used when it is the only w
   check_legs_clear(planner, {1.0, 1.0}, route);
 }
 
-TEST_CASE("no route into a closed room; a goal inside a wall moves to the nearest free cell") {
-  const GridMap map = grid_from_text({"###########", "#...#.....#", "#...#.....#", "#...#.....#", "###########"},
-                                     0.5);
-  const RoutePlanner planner(map);
+TEST_CASE("no route into a closed room") {
+  const RoutePlanner planner(two_closed_rooms_map());
   CHECK(planner.plan({1.0, 1.0}, {4.0, 1.0}, 0.3).waypoints.empty());
+}
+
+TEST_CASE("a goal inside a wall moves to the nearest free cell") {
+  const RoutePlanner planner(two_closed_rooms_map());
   // (2.25, 1.25) is in the dividing wall (column 4); the nearest free cell centre is (1.75, 1.25).
   const PlannedRoute route = planner.plan({1.0, 1.0}, {2.1, 1.25}, 0.0);
   REQUIRE(route.waypoints.size() == 1);

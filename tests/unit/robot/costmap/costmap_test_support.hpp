@@ -15,6 +15,9 @@
 
 namespace rfbsim::sim::costmap_test {
 
+/// A quiet NaN, for the tests of bad input.
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 // A room of cols x rows cells at `res` with walls on its border and wall cells at `inner`.
 inline GridMap room(int cols, int rows, double res, std::initializer_list<Cell> inner = {}) {
   GridMap map;

@@ -15,10 +15,6 @@
 using namespace rfbsim::sim;
 using namespace rfbsim::sim::costmap_test;
 
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-}  // namespace
-
 TEST_CASE("the global costmap covers the map and inflates its walls by the formula") {
   // 3 x 2.5 m at 0.05 m: border walls and one wall cell at (30, 25).
   const GridMap map = room(60, 50, 0.05, {{30, 25}});
@@ -145,22 +141,46 @@ TEST_CASE("clearing the obstacles beyond a radius keeps the near marks and rewri
   CHECK(marks_of(costmap).mark_count() == 0);
 }
 
-TEST_CASE("bad input: a NaN pose, an empty scan, bad angles, NaN people; nothing crashes") {
+TEST_CASE("bad input: an empty scan is used and marks nothing") {
   const GridMap map = room(40, 40, 0.05);
   LayeredCostmap costmap(map, global_costmap_params());
   const LaserScan empty = scan(0.0, 0.0, {});
-  CostmapUpdateReport report = costmap.update({1.0, 1.0, 0.0}, &empty, {});
+  const CostmapUpdateReport report = costmap.update({1.0, 1.0, 0.0}, &empty, {});
   CHECK(report.scan_used);
   CHECK(marks_of(costmap).mark_count() == 0);
+}
+
+TEST_CASE("bad input: a scan whose angles are not finite is skipped, saying so") {
+  const GridMap map = room(40, 40, 0.05);
+  LayeredCostmap costmap(map, global_costmap_params());
   LaserScan bad = scan(0.0, 0.0, {0.5f});
   bad.angle_min = kNaN;
-  report = costmap.update({1.0, 1.0, 0.0}, &bad, {});
+  const CostmapUpdateReport report = costmap.update({1.0, 1.0, 0.0}, &bad, {});
+  CHECK_FALSE(report.scan_used);
   CHECK(std::string(report.scan_skipped) == "scan angles are not finite");
+  CHECK(marks_of(costmap).mark_count() == 0);
+}
+
+TEST_CASE("bad input: a NaN pose and NaN people crash nothing, and the person with a position is drawn") {
+  const GridMap map = room(40, 40, 0.05);
+  LayeredCostmap costmap(map, global_costmap_params());
+  const LaserScan empty = scan(0.0, 0.0, {});
   const std::vector<SeenPerson> people{person_at(kNaN, 1.0), person_at(1.0, 1.5, kNaN, 0.0)};
-  report = costmap.update({kNaN, kNaN, kNaN}, &empty, people);
+  const CostmapUpdateReport report = costmap.update({kNaN, kNaN, kNaN}, &empty, people);
+  CHECK(std::string(report.scan_skipped) == "robot pose is not finite");
   CHECK(report.people_used == 1);
   CHECK(costmap.grid().at_world(1.0, 1.5) == 76);  // 77 exp(-(0.025^2 + 0.025^2) / 0.5) at the cell's centre
+}
+
+TEST_CASE("bad input: clearing obstacles beyond a NaN centre drops nothing") {
+  const GridMap map = room(40, 40, 0.05);
+  LayeredCostmap costmap(map, global_costmap_params());
+  const LaserScan one_return = scan(0.0, 0.0, {0.5f});
+  costmap.update({0.51, 1.01, 0.0}, &one_return, {});
+  REQUIRE(marks_of(costmap).mark_count() == 1);
   CHECK(costmap.clear_obstacles_beyond({kNaN, 0.0}, 1.0) == 0);
+  CHECK(marks_of(costmap).mark_count() == 1);
+  CHECK(costmap.grid().at_world(1.01, 1.01) == 254);
 }
 
 TEST_CASE("layers can be switched off") {

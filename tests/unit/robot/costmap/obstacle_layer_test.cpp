@@ -12,17 +12,22 @@
 #include "robot/costmap/obstacle_layer.hpp"
 
 using namespace rfbsim::sim;
+using costmap_test::kNaN;
 using costmap_test::scan;
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 CostmapGrid frame() { return CostmapGrid::sized(100, 100, 0.05, 0.0, 0.0); }
 
 // The robot sits a fifth of a cell into cell (20, 50), so returns at whole multiples of 0.05 m along the
 // axes land a fifth into a cell, never on a boundary.
 const Pose2 kRobot{1.01, 2.51, 0.0};
+
+// Marks returns at 0.5 m (+x), 1.5 m (+y), 0.9 m (-x) and 2.0 m (-y) from kRobot.
+void mark_four_returns_around_robot(ObstacleLayer& layer) {
+  layer.add_scan(kRobot, scan(0.0, std::numbers::pi / 2, {0.5f, 1.5f, 0.9f, 2.0f}));
+  REQUIRE(layer.mark_count() == 4);
+}
 
 }  // namespace
 
@@ -129,21 +134,29 @@ TEST_CASE("the footprint is cleared of marks, the rest is kept") {
   CHECK(layer.mark_count() == 1);
 }
 
-TEST_CASE("clear_beyond keeps near marks and drops far ones; clear_all drops all") {
+TEST_CASE("clear_beyond keeps near marks and drops far ones") {
   ObstacleLayer layer(ObstacleLayerParams{}, frame(), 0.16);
-  // Returns at 0.5 m (+x), 1.5 m (+y), 0.9 m (-x) and 2.0 m (-y).
-  layer.add_scan(kRobot, scan(0.0, std::numbers::pi / 2, {0.5f, 1.5f, 0.9f, 2.0f}));
-  REQUIRE(layer.mark_count() == 4);
+  mark_four_returns_around_robot(layer);
   CHECK(layer.clear_beyond({kRobot.x, kRobot.y}, 1.0) == 2);
   CHECK(layer.is_marked_at(1.51, 2.51));
   CHECK(layer.is_marked_at(0.11, 2.51));
   CHECK_FALSE(layer.is_marked_at(1.01, 4.01));
   CHECK_FALSE(layer.is_marked_at(1.01, 0.51));
-  CHECK(layer.clear_beyond({kNaN, 0.0}, 1.0) == 0);
   CHECK(layer.mark_count() == 2);
-  CHECK(layer.clear_beyond({kRobot.x, kRobot.y}, -1.0) == 2);  // a negative distance: everything
+}
+
+TEST_CASE("clear_beyond drops nothing around a NaN centre and everything at a negative distance") {
+  ObstacleLayer layer(ObstacleLayerParams{}, frame(), 0.16);
+  mark_four_returns_around_robot(layer);
+  CHECK(layer.clear_beyond({kNaN, 0.0}, 1.0) == 0);
+  CHECK(layer.mark_count() == 4);
+  CHECK(layer.clear_beyond({kRobot.x, kRobot.y}, -1.0) == 4);  // a negative distance: everything
   CHECK(layer.mark_count() == 0);
-  layer.add_scan(kRobot, scan(0.0, std::numbers::pi / 2, {0.5f, 1.5f}));
+}
+
+TEST_CASE("clear_all drops all marks") {
+  ObstacleLayer layer(ObstacleLayerParams{}, frame(), 0.16);
+  mark_four_returns_around_robot(layer);
   layer.clear_all();
   CHECK(layer.mark_count() == 0);
   CHECK(std::all_of(layer.marks().costs.begin(), layer.marks().costs.end(), [](std::uint8_t c) { return c == 0; }));

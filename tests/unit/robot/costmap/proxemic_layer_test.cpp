@@ -8,9 +8,11 @@
 #include <numbers>
 #include <vector>
 
+#include "costmap_test_support.hpp"
 #include "robot/costmap/proxemic_layer.hpp"
 
 using namespace rfbsim::sim;
+using costmap_test::person_at;
 
 namespace {
 
@@ -18,13 +20,6 @@ namespace {
 CostmapGrid centred_grid() { return CostmapGrid::sized(161, 161, 0.05, -4.025, -4.025); }
 
 std::uint8_t at(const CostmapGrid& g, double x, double y) { return g.at_world(x, y, 99); }
-
-SeenPerson person_at(double x, double y, double vx = 0.0, double vy = 0.0) {
-  SeenPerson p;
-  p.position = {x, y};
-  p.velocity = {vx, vy};
-  return p;
-}
 
 // docs/sources.md's formula, written out again here: cov 0.25, amplitude 77, factor 5.
 double formula(double x, double y, double sx2, double sy2) {
@@ -94,19 +89,34 @@ TEST_CASE("the stretch turns with the walking direction") {
   CHECK(at(d, 0.5, 0.5) == static_cast<int>(std::floor(formula(std::hypot(0.5, 0.5), 0.0, front_variance, 0.25))));
 }
 
-TEST_CASE("each cell keeps the max of what it held and the person's cost; below-cutoff cells are untouched") {
+TEST_CASE("each cell keeps the max of what it held and the person's cost") {
   const ProxemicLayer layer{ProxemicLayerParams{}};
   CostmapGrid g = centred_grid();
   std::fill(g.costs.begin(), g.costs.end(), std::uint8_t{30});
   layer.stamp(g, person_at(0.0, 0.0), CellWindow::whole(g.width, g.height));
   CHECK(at(g, 0.5, 0.0) == 46);  // raised
   CHECK(at(g, 1.0, 0.0) == 30);  // 10 < 30: kept
-  CHECK(at(g, 3.0, 0.0) == 30);  // far away: kept
   // Two people: the max of both, not the sum.
   CostmapGrid two = centred_grid();
   layer.stamp(two, person_at(-0.5, 0.0), CellWindow::whole(two.width, two.height));
   layer.stamp(two, person_at(0.5, 0.0), CellWindow::whole(two.width, two.height));
   CHECK(at(two, 0.0, 0.0) == 46);
+}
+
+TEST_CASE("a person's stamp leaves the cells below the cutoff untouched") {
+  const ProxemicLayer layer{ProxemicLayerParams{}};
+  CostmapGrid g = centred_grid();
+  std::fill(g.costs.begin(), g.costs.end(), std::uint8_t{30});
+  layer.stamp(g, person_at(0.0, 0.0), CellWindow::whole(g.width, g.height));
+  CHECK(at(g, 3.0, 0.0) == 30);  // far away: kept
+  // Beyond 2 m the cost is below 77 exp(-8) < 0.03: every such cell still holds what it held.
+  int changed = 0;
+  for (int row = 0; row < g.height; ++row) {
+    for (int col = 0; col < g.width; ++col) {
+      if (g.cell_centre({col, row}).norm() > 2.0 && g.at({col, row}) != 30) ++changed;
+    }
+  }
+  CHECK(changed == 0);
 }
 
 TEST_CASE("a proxemic stamp writes only inside its clip window") {

@@ -14,10 +14,6 @@
 using namespace rfbsim::sim;
 using namespace rfbsim::sim::costmap_test;
 
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-}  // namespace
-
 TEST_CASE("the rolling window follows the robot and keeps obstacle marks in world coordinates") {
   const GridMap map = room(100, 80, 0.1);  // 10 x 8 m at 0.1 m
   LayeredCostmap costmap(map, local_costmap_params());

@@ -15,11 +15,11 @@ using namespace rfbsim::sim::test;
 
 namespace {
 
-constexpr double kRes = 0.05;
+constexpr double kWindowRes = 0.05;
 // The robot stands at the centre of cell (40, 40) of an 80 x 80 window.
 const Pose2 kRobot{2.025, 2.025, 0.0};
 
-CostmapGrid free_window() { return CostmapGrid::sized(80, 80, kRes, 0.0, 0.0); }
+CostmapGrid free_window() { return CostmapGrid::sized(80, 80, kWindowRes, 0.0, 0.0); }
 
 // Points every 2.5 cm from a to b.
 std::vector<Eigen::Vector2d> line(Eigen::Vector2d a, Eigen::Vector2d b) {
