@@ -204,6 +204,7 @@ rfbsim::sim::SessionSetup setup_of(const rfbsim::sim::SimOptions& options) {
   setup.seed = options.seed;
   setup.tick_hz = options.tick_hz;
   if (options.time_limit) setup.time_limit = *options.time_limit;
+  if (options.end_grace) setup.end_grace = *options.end_grace;
   const std::pair<const char*, const std::optional<std::string>*> poses[] = {
       {"avatar_start", &options.avatar_start}, {"avatar_goal", &options.avatar_goal},
       {"robot_start", &options.robot_start}, {"robot_goal", &options.robot_goal}};

@@ -89,7 +89,7 @@ std::string sim_usage() {
          "               [--debug-overlay] [--rfb-only] [--proxy-protocol] [--ready-fd N]\n"
          "               [--allow-origin ORIGIN]... [--unix-socket PATH]\n"
          "               [--data-dir DIR] [--uid ID] [--code-success C] [--code-timeout C]\n"
-         "               [--time-limit S] [--trajectory-hz N] [--no-mcap] [--robot-control C]\n"
+         "               [--time-limit S] [--end-grace S] [--trajectory-hz N] [--no-mcap] [--robot-control C]\n"
          "               [--rosbridge-port N] [--rosbridge-bind ADDR] [--rosbridge-connect URL]\n"
          "               [--rosbridge-token-file F] [--rosbridge-ca F] [--ros-namespace NS]\n"
          "               [--cmd-vel-type twist|twist_stamped]\n"
@@ -136,6 +136,8 @@ std::string sim_usage() {
          "                   completion codes shown when the task is done or the time is up (1..64 of\n"
          "                   letters, digits, - and _; SEAN-EP's t1 and t2)\n"
          "  --time-limit S   the task's time limit in seconds, 1..86400 (default: the scenario's)\n"
+         "  --end-grace S    seconds the outcome and the code stay on screen before the session ends, 0..3600\n"
+         "                   (default: the scenario's end_grace)\n"
          "  --trajectory-hz N  trajectory rows per second, a divisor of the tick rate 60 (default 10)\n"
          "  --no-mcap        with --data-dir, do not write session.mcap (the ROS 2 bag, docs/ros.md)\n"
          "  --robot-control C  builtin (the robot's own navigation stack) or external (/cmd_vel over rosbridge\n"
@@ -210,6 +212,12 @@ ParseOutcome parse_sim_options(const std::vector<std::string>& args) {
          int seconds = 0;
          if (!parse_number(v, 1, 86400, seconds)) return false;
          o.time_limit = seconds;
+         return true;
+       }},
+      {"--end-grace", [&](const std::string& v) {
+         int seconds = 0;
+         if (!parse_number(v, 0, 3600, seconds)) return false;
+         o.end_grace = seconds;
          return true;
        }},
       {"--trajectory-hz", [&](const std::string& v) {

@@ -49,6 +49,7 @@ struct SimOptions {
   std::string code_success;         ///< completion code shown on success (SEAN-EP's t1); empty = none
   std::string code_timeout;         ///< completion code shown on timeout (t2); empty = none
   std::optional<int> time_limit;    ///< s, the task's time limit instead of the scenario's
+  std::optional<int> end_grace;     ///< s the outcome stays on screen before the end, instead of the scenario's
   int trajectory_hz = 10;           ///< trajectory rows per second; divides tick_hz
   bool mcap = true;                 ///< with data_dir, also write session.mcap (--no-mcap: not)
   /// Who drives the robot: "builtin" or "external" (a link parameter like the poses; unset = the scenario's).

@@ -64,6 +64,7 @@ PreparedSession prepare_session(const SessionSetup& setup) {
   Scenario scenario = load_scenario(file);
   apply_overrides(scenario, overrides_of(setup));
   if (setup.time_limit) scenario.task.time_limit = *setup.time_limit;
+  if (setup.end_grace) scenario.task.end_grace = *setup.end_grace;
 
   info.scenario = scenario.name;
   if (scenario.robot.present) info.robot_control = robot_control_name(scenario.robot.control);
@@ -72,7 +73,10 @@ PreparedSession prepare_session(const SessionSetup& setup) {
   info.scenario_sha256 = sha256_file(file);
   info.map_sha256 = sha256_file(scenario.map_image);
   for (const TaskStep& step : scenario.task.steps) info.tasks.emplace_back(task_type_name(step.type), task_step_text(step));
-  if (!scenario.task.steps.empty()) info.time_limit = scenario.task.time_limit;
+  if (!scenario.task.steps.empty()) {
+    info.time_limit = scenario.task.time_limit;
+    info.end_grace = scenario.task.end_grace;
+  }
   prepared.task = scenario.task;
   prepared.simulation = std::make_unique<Simulation>(params, make_world(scenario), scenario.crowd, robot_setup(scenario));
   return prepared;

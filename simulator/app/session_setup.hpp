@@ -25,6 +25,7 @@ struct SessionSetup {
   std::optional<std::uint64_t> seed;  ///< unset = the scenario's (and its crowd's own, if it has one)
   int tick_hz = 60;
   std::optional<double> time_limit;  ///< s, overrides the scenario's task time limit
+  std::optional<double> end_grace;   ///< s, overrides the scenario's task end_grace
 };
 
 /// A session ready to run.

@@ -196,6 +196,10 @@ SessionMeta parse_meta(const json& doc, const Where& where) {
     meta.tasks.push_back({get_string(task, "type", where), get_string(task, "text", where)});
   }
   if (!need(doc, "time_limit_s", where).is_null()) meta.time_limit_s = get_number(doc, "time_limit_s", where);
+  // Optional: files written before --end-grace existed ran with their scenario's end_grace.
+  if (const auto grace = doc.find("end_grace_s"); grace != doc.end() && !grace->is_null()) {
+    meta.end_grace_s = get_number(doc, "end_grace_s", where);
+  }
   if (!need(doc, "codes", where).is_null()) {
     const json& codes = get_object(doc, "codes", where);
     meta.success_code = get_optional_string(codes, "success", where);

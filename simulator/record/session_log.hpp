@@ -76,6 +76,7 @@ struct SessionMeta {
   std::vector<SessionAgent> agents;  ///< every agent in trajectories.csv
   std::vector<SessionTask> tasks;
   std::optional<double> time_limit_s;  ///< s; none without tasks
+  std::optional<double> end_grace_s;   ///< s from the outcome to the end; none without tasks or in older files
   std::optional<std::string> success_code, timeout_code;  ///< the link's completion codes, if any
   std::string started_at;                ///< ISO 8601 UTC
   std::optional<std::string> ended_at;   ///< none while running or after a crash

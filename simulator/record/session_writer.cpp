@@ -111,6 +111,7 @@ SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const 
               {"agents", agents},
               {"tasks", tasks},
               {"time_limit_s", info_.time_limit ? json(*info_.time_limit) : json(nullptr)},
+              {"end_grace_s", info_.end_grace ? json(*info_.end_grace) : json(nullptr)},
               {"codes", info_.codes ? json{{"success", info_.codes->first}, {"timeout", info_.codes->second}}
                                     : json(nullptr)},
               {"robot_control", info_.robot_control.empty() ? json(nullptr) : json(info_.robot_control)},

@@ -38,6 +38,7 @@ struct SessionInfo {
   std::string rfbsim_version, build, scenario_sha256, map_sha256;
   std::vector<std::pair<std::string, std::string>> tasks;  ///< (type, text) per step
   std::optional<double> time_limit;  ///< s; none without a task
+  std::optional<double> end_grace;   ///< s from the outcome to the session's end; none without a task
   std::optional<std::pair<std::string, std::string>> codes;  ///< (success, timeout)
   std::string robot_control;  ///< who drives the robot: "builtin" or "external"; empty = no robot
   /// What the session gave ROS (docs/ros.md): the bag's file name, the bridge ("server ADDR:PORT" or

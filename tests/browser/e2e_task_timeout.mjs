@@ -13,15 +13,18 @@ import { check, log, parseManagerArgs, runTest, stopSimCleanly } from './e2e_sup
 import { CODE_TIMEOUT, checkEnd, readEvents, startTaskSession, taskStory } from './e2e_task_support.mjs';
 
 const UID = 'e2e-task-idle';
-const TIME_LIMIT_S = 8;   // instead of the warehouse's 240 s; its end_grace (15 s) stays
+const TIME_LIMIT_S = 8;   // instead of the warehouse's 240 s
+const END_GRACE_S = 3;    // instead of its 15 s: the session ends 3 s after the timeout
 const env = parseManagerArgs('e2e_task_timeout.mjs');
 
 async function main() {
   const run = await startTaskSession(env, {
-    tag: 'task_timeout', uid: UID, sessionArgs: ['--time-limit', String(TIME_LIMIT_S)],
+    tag: 'task_timeout', uid: UID,
+    sessionArgs: ['--time-limit', String(TIME_LIMIT_S), '--end-grace', String(END_GRACE_S)],
   });
-  check(run.session.time_limit_s === TIME_LIMIT_S,
-        `session.json: time_limit_s ${run.session.time_limit_s}, expected ${TIME_LIMIT_S}`);
+  check(run.session.time_limit_s === TIME_LIMIT_S && run.session.end_grace_s === END_GRACE_S,
+        `session.json: time_limit_s ${run.session.time_limit_s}, end_grace_s ${run.session.end_grace_s}, expected ` +
+        `${TIME_LIMIT_S} and ${END_GRACE_S}`);
   await run.shot('start');
   log(`the participant does nothing; the task times out after ${TIME_LIMIT_S} s`);
 

@@ -13,6 +13,7 @@
 
 #include "app/session_setup.hpp"
 #include "app/study_session.hpp"
+#include "record/session_log.hpp"
 #include "scratch_dir.hpp"
 
 using namespace rfbsim::sim;
@@ -167,6 +168,7 @@ TEST_CASE("a participant who does nothing in the lab times out at the limit and 
   CHECK(session["completion"]["code"] == "LATE-2");
   CHECK(session["completion"]["tick"] == 210);
   CHECK(session["time_limit_s"] == 3.0);
+  CHECK(session["end_grace_s"] == 15.0);  // the lab's
   CHECK(session["end_tick"] == 210 + 15 * 60);
   // Every agent is in every sample: avatar, robot and the lab's one pedestrian.
   const auto rows = lines_of(dir / "trajectories.csv");
@@ -175,6 +177,31 @@ TEST_CASE("a participant who does nothing in the lab times out at the limit and 
   REQUIRE(agents.size() == 3);
   CHECK(agents[1]["kind"] == "robot");
   CHECK(agents[1]["radius"] == 0.16);
+}
+
+TEST_CASE("an end grace given instead of the scenario's ends the session that much after the outcome, recorded") {
+  SessionSetup setup;
+  setup.scenario = "lab";
+  setup.time_limit = 3.0;
+  setup.end_grace = 2.0;
+  PreparedSession prepared = prepare_session(setup);
+  Simulation& simulation = *prepared.simulation;
+  ScratchDir scratch;
+  const auto dir = scratch.path() / "lab_short_grace";
+  {
+    SessionWriter writer(dir, info_for(prepared, "p-grace"), simulation.world());
+    StudySession study(simulation, prepared.task, {"OK-1", "LATE-2"}, &writer);
+    study.client_connected(1, "0123456789abcdef", true);  // the clock starts at tick 0
+    while (!study.over() && simulation.world().tick < 60 * 60) study.step();
+    REQUIRE(study.outcome() == TaskOutcome::Timeout);
+    CHECK(*study.task().outcome_tick() == 180);
+    study.finish("timeout");
+  }
+  const json session = read_json(dir / "session.json");
+  CHECK(session["end_grace_s"] == 2.0);
+  CHECK(session["end_tick"] == 180 + 2 * 60);
+  // Read back as sim_replay reads it, which rebuilds the session with the same grace.
+  CHECK(rfbsim::sim::read_session(dir).meta.end_grace_s == 2.0);
 }
 
 TEST_CASE("a researcher watching before the participant comes does not start the participant's clock") {

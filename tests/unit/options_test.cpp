@@ -112,3 +112,12 @@ TEST_CASE("the codec option takes auto, jpeg or h264 and names the choices when 
   CHECK(parse_sim_options({"--codec"}).error == "--codec needs a value");
   CHECK(rfbsim::sim::sim_usage().find("--codec auto|jpeg|h264") != std::string::npos);
 }
+
+TEST_CASE("the end grace option takes whole seconds from 0 to 3600 and is unset by default") {
+  CHECK_FALSE(parse_sim_options({}).options.end_grace);
+  CHECK(parse_sim_options({"--end-grace", "0"}).options.end_grace == 0);
+  CHECK(parse_sim_options({"--end-grace", "3600"}).options.end_grace == 3600);
+  CHECK(parse_sim_options({"--end-grace", "3601"}).error == "bad value '3601' for --end-grace");
+  CHECK(parse_sim_options({"--end-grace", "-1"}).error == "bad value '-1' for --end-grace");
+  CHECK(parse_sim_options({"--end-grace", "2.5"}).error == "bad value '2.5' for --end-grace");
+}

@@ -42,6 +42,7 @@ sim::SessionSetup setup_of(const sim::SessionMeta& meta) {
   }
   setup.tick_hz = meta.tick_hz;
   setup.time_limit = meta.time_limit_s;
+  setup.end_grace = meta.end_grace_s;
   return setup;
 }
 

@@ -27,7 +27,9 @@ TEST_CASE("a timed-out task reaches the page's status, the index and the session
           "[manager][study][waits]") {
   TempDir data;
   ::setenv("RFBSIM_ADDRESS_KEY", "study-key-for-the-test", 1);  // inherited by the manager and its sessions
-  ManagerUnderTest manager(data.path(), with_small_sessions({"--session-arg", "--time-limit", "--session-arg", "2"}));
+  // A 2 s task, and 2 s of grace after it instead of the warehouse's 15 (sim_rfb --end-grace).
+  ManagerUnderTest manager(data.path(), with_small_sessions({"--session-arg", "--time-limit", "--session-arg", "2",
+                                                             "--session-arg", "--end-grace", "--session-arg", "2"}));
   ::unsetenv("RFBSIM_ADDRESS_KEY");
   const std::string token = token_from_redirect(manager.start("uid=study-1&scenario=warehouse&t1=WELL-DONE&t2=TOO-LATE"));
   REQUIRE(token.size() == 32);
@@ -67,6 +69,7 @@ TEST_CASE("a timed-out task reaches the page's status, the index and the session
       10s));
   const json session = json::parse(std::ifstream(folder / "session.json"));
   CHECK(session["uid"] == "study-1");
+  CHECK(session["end_grace_s"] == 2.0);
   CHECK(session["scenario"] == "warehouse");
   CHECK(session["completion"]["code"] == "TOO-LATE");
   CHECK(session["codes"]["success"] == "WELL-DONE");
