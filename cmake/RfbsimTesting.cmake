@@ -20,7 +20,7 @@
 #
 #   rfbsim_test_load(<test>... CPU <percent> [COST <seconds>] [BROWSER])
 #     The same accounting for tests added with add_test: CPU as above, COST its usual seconds, BROWSER for a
-#     test that drives Chromium (one at a time: their timing checks must not share the cores with another).
+#     test that drives Chromium (at most RFBSIM_BROWSERS_AT_ONCE of them run at once).
 #
 # With RFBSIM_NO_SKIP=1 in the environment (scripts/test.sh and CI set it: they install everything the tests
 # need) every skip fails instead, naming what is missing.
@@ -33,13 +33,16 @@
 set(RFBSIM_SKIP_MARKER "RFBSIM-SKIPPED:")
 set(RFBSIM_WAITS_CPU 20)
 set(RFBSIM_LONG_COST 100)
+# Chromium tests at once: each is a browser, a renderer and a simulator, about half a core on average.
+set(RFBSIM_BROWSERS_AT_ONCE 2)
 
 cmake_host_system_information(RESULT _rfbsim_cores QUERY NUMBER_OF_LOGICAL_CORES)
 math(EXPR _rfbsim_cpu_slots "${_rfbsim_cores} * 100")
 set(RFBSIM_CTEST_RESOURCES "${PROJECT_BINARY_DIR}/ctest-resources.json")
 file(WRITE "${RFBSIM_CTEST_RESOURCES}"
      "{\"version\": {\"major\": 1, \"minor\": 0},\n"
-     " \"local\": [{\"cpu\": [{\"id\": \"cores\", \"slots\": ${_rfbsim_cpu_slots}}]}]}\n")
+     " \"local\": [{\"cpu\": [{\"id\": \"cores\", \"slots\": ${_rfbsim_cpu_slots}}],\n"
+     "            \"chromium\": [{\"id\": \"browsers\", \"slots\": ${RFBSIM_BROWSERS_AT_ONCE}}]}]}\n")
 set(CTEST_RESOURCE_SPEC_FILE "${RFBSIM_CTEST_RESOURCES}")
 
 # Whether any source of `target` tags a test case with `tag` (e.g. "[waits]").
@@ -101,12 +104,13 @@ endfunction()
 
 function(rfbsim_test_load)
   cmake_parse_arguments(PARSE_ARGV 0 arg "BROWSER" "CPU;COST" "")
-  set(properties RESOURCE_GROUPS "cpu:${arg_CPU}")
+  set(resources "cpu:${arg_CPU}")
+  if(arg_BROWSER)
+    string(APPEND resources ",chromium:1")
+  endif()
+  set(properties RESOURCE_GROUPS "${resources}")
   if(DEFINED arg_COST)
     list(APPEND properties COST ${arg_COST})
-  endif()
-  if(arg_BROWSER)
-    list(APPEND properties RESOURCE_LOCK chromium)
   endif()
   set_tests_properties(${arg_UNPARSED_ARGUMENTS} PROPERTIES ${properties})
 endfunction()

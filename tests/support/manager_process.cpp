@@ -278,17 +278,21 @@ net::HttpResponse admin_post(const ManagerUnderTest& manager, const std::string&
 }
 
 int free_loopback_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw std::runtime_error("free_loopback_port: socket failed");
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof address;
-  const bool bound = ::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0 &&
-                     ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0;
-  ::close(fd);
-  if (!bound) throw std::runtime_error("free_loopback_port: no loopback port to bind");
-  return ntohs(address.sin_port);
+  std::mt19937 random(static_cast<unsigned>(::getpid()) ^ static_cast<unsigned>(std::random_device{}()));
+  std::uniform_int_distribution<int> pick(10000, 19999);
+  for (int attempt = 0; attempt < 200; ++attempt) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (fd < 0) throw std::runtime_error("free_loopback_port: socket failed");
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const int port = pick(random);
+    address.sin_port = htons(static_cast<std::uint16_t>(port));
+    const bool bound = ::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0;
+    ::close(fd);
+    if (bound) return port;
+  }
+  throw std::runtime_error("free_loopback_port: no free loopback port in 10000-19999");
 }
 
 bool process_exists(pid_t pid) {
@@ -300,6 +304,35 @@ bool group_has_running_member(pid_t pgid) {
   const std::vector<ProcStat> processes = all_processes();
   return std::any_of(processes.begin(), processes.end(),
                      [pgid](const ProcStat& stat) { return stat.group == pgid && stat.state != 'Z'; });
+}
+
+std::vector<pid_t> listener_groups(int port) {
+  // The sockets' inodes, then the processes holding a descriptor of one.
+  std::vector<std::string> inodes;
+  for (const char* file : {"/proc/net/tcp", "/proc/net/tcp6"}) {
+    std::ifstream table(file);
+    std::string line;
+    std::getline(table, line);  // header
+    while (std::getline(table, line)) {
+      std::istringstream fields(line);
+      std::string slot, local, remote, state, queues, timer, retransmits, uid, timeout, inode;
+      fields >> slot >> local >> remote >> state >> queues >> timer >> retransmits >> uid >> timeout >> inode;
+      if (state == "0A" && std::stoi(local.substr(local.find(':') + 1), nullptr, 16) == port) {
+        inodes.push_back("socket:[" + inode + "]");
+      }
+    }
+  }
+  std::vector<pid_t> groups;
+  if (inodes.empty()) return groups;
+  for (const ProcStat& process : all_processes()) {
+    std::error_code error;
+    const std::filesystem::path fds = "/proc/" + std::to_string(process.pid) + "/fd";
+    for (const auto& fd : std::filesystem::directory_iterator(fds, error)) {
+      const std::string target = std::filesystem::read_symlink(fd.path(), error).string();
+      if (std::find(inodes.begin(), inodes.end(), target) != inodes.end()) groups.push_back(process.group);
+    }
+  }
+  return groups;
 }
 
 std::vector<int> listening_ports() {

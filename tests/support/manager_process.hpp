@@ -139,7 +139,10 @@ inline constexpr const char* kAdminToken = "test-admin-token-0123456789";
 /// POST `path` to `manager` with kAdminToken and, unless told not to, the admin API's X-Rfbsim-Admin header.
 net::HttpResponse admin_post(const ManagerUnderTest& manager, const std::string& path, bool admin_header = true);
 
-/// A loopback TCP port that was free a moment ago (bound as port 0, read back, released).
+/// A loopback TCP port that was free a moment ago, for a program that must be told its port before it starts.
+/// Drawn at random from 10000-19999: below the kernel's ephemeral ports, which every port-0 bind of the tests
+/// running beside this one takes from, and below the cluster tests' 20000-31999, so that a port seen free is
+/// rarely taken before the program binds it.
 int free_loopback_port();
 
 /// Whether a process with this id exists (zombies count as gone).
@@ -150,5 +153,9 @@ bool group_has_running_member(pid_t pgid);
 
 /// TCP ports in LISTEN state on this machine (from /proc/net/tcp).
 std::vector<int> listening_ports();
+
+/// The process groups of the processes listening on TCP `port` now (from /proc/net/tcp and /proc/*/fd): a
+/// port another test took meanwhile is told apart from one a session left behind.
+std::vector<pid_t> listener_groups(int port);
 
 }  // namespace rfbsim::test
