@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-# How tests join ctest (docs/development.md, "Skips" and "How ctest packs the cores"):
+# How tests join ctest (docs/development.md, "Skips" and "How ctest shares the cores"):
 #
 #   rfbsim_add_catch_tests(<target> PREFIX <text> [SPEC <catch test spec>] [CPU <percent>]
 #                          [ALL_ALIKE [COST <seconds>]] [PROPERTIES <name> <value>...])
@@ -7,10 +7,10 @@
 #     cannot run its real part here says so (RFBSIM_SKIP, tests/support/skip.hpp) and ctest shows it Skipped;
 #     a ctest name that matches no test case fails (--warn NoTests) instead of passing with nothing run.
 #     Test case names must not contain ';' (a CMake list separator: the name would be cut in two).
-#     CPU is how much of one core a test of the executable typically keeps busy (default 100); two tags on a
-#     test case say otherwise for it:
-#       [waits]  it takes seconds and spends them waiting (a timeout, a backoff, a minute of streaming): 20
-#       [busy]   it keeps a core busy for seconds (long simulations, floods of clients): 100
+#     CPU is how much of one core, in percent, a test of the executable typically keeps busy (default 100);
+#     two tags on a test case say otherwise for it:
+#       [waits]  it takes seconds and spends them waiting (a timeout, a backoff, a minute of streaming): 5
+#       [busy]   it keeps most of a core busy for seconds (long simulations, floods of clients): 80
 #     Both tags also mark a test as long, so that ctest starts it early (COST) instead of last. ALL_ALIKE: the
 #     tags are not looked at, every test of SPEC takes CPU and, where given, COST.
 #
@@ -20,20 +20,24 @@
 #
 #   rfbsim_test_load(<test>... CPU <percent> [COST <seconds>] [BROWSER])
 #     The same accounting for tests added with add_test: CPU as above, COST its usual seconds, BROWSER for a
-#     test that drives Chromium (at most RFBSIM_BROWSERS_AT_ONCE of them run at once).
+#     test that drives Chromium: at most RFBSIM_BROWSERS_AT_ONCE of them run at once, and they start before
+#     every other test (COST + 200), since two lanes of them are the run's longest chain.
 #
 # With RFBSIM_NO_SKIP=1 in the environment (scripts/test.sh and CI set it: they install everything the tests
 # need) every skip fails instead, naming what is missing.
 #
 # Packing: every test holds RESOURCE_GROUPS "cpu:<percent>" of a pool of 100 per core (ctest-resources.json,
 # written here and named by CTEST_RESOURCE_SPEC_FILE), so `ctest -j <many>` runs waiting tests side by side
-# while tests that compute never ask for more cores than the machine has. A plain `ctest -j 2` works as before.
+# while tests that compute never ask for more cores than the machine has. A plain `ctest -j 2` uses the same
+# pool and simply runs no more than two tests at a time.
 
 # The start of a skip's line; tests/support/skip.hpp's kSkipMarker is the same text.
 set(RFBSIM_SKIP_MARKER "RFBSIM-SKIPPED:")
-set(RFBSIM_WAITS_CPU 20)
-set(RFBSIM_LONG_COST 100)
-# Chromium tests at once: each is a browser, a renderer and a simulator, about half a core on average.
+set(RFBSIM_WAITS_CPU 5)
+set(RFBSIM_WAITS_COST 60)
+set(RFBSIM_BUSY_CPU 80)
+set(RFBSIM_BUSY_COST 50)
+# Chromium tests at once: each is a browser, a renderer and a simulator, 0.4 of a core on average.
 set(RFBSIM_BROWSERS_AT_ONCE 2)
 
 cmake_host_system_information(RESULT _rfbsim_cores QUERY NUMBER_OF_LOGICAL_CORES)
@@ -87,12 +91,12 @@ function(rfbsim_add_catch_tests target)
   if(has_waits)
     string(APPEND plain "~[waits]")
     catch_discover_tests(${target} TEST_SPEC "${arg_SPEC}[waits]" ${common} PROPERTIES ${properties}
-                         RESOURCE_GROUPS "cpu:${RFBSIM_WAITS_CPU}" COST ${RFBSIM_LONG_COST})
+                         RESOURCE_GROUPS "cpu:${RFBSIM_WAITS_CPU}" COST ${RFBSIM_WAITS_COST})
   endif()
   if(has_busy)
     string(APPEND plain "~[busy]")
     catch_discover_tests(${target} TEST_SPEC "${arg_SPEC}[busy]~[waits]" ${common} PROPERTIES ${properties}
-                         RESOURCE_GROUPS "cpu:100" COST ${RFBSIM_LONG_COST})
+                         RESOURCE_GROUPS "cpu:${RFBSIM_BUSY_CPU}" COST ${RFBSIM_BUSY_COST})
   endif()
   set(spec_args "")
   if(NOT plain STREQUAL "")
@@ -109,6 +113,10 @@ function(rfbsim_test_load)
     string(APPEND resources ",chromium:1")
   endif()
   set(properties RESOURCE_GROUPS "${resources}")
+  if(arg_BROWSER)
+    # The browser tests, two at a time, are the run's longest chain: they start before everything else.
+    math(EXPR arg_COST "200 + 0${arg_COST}")
+  endif()
   if(DEFINED arg_COST)
     list(APPEND properties COST ${arg_COST})
   endif()
