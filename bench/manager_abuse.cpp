@@ -22,7 +22,7 @@ namespace {
 using std::chrono::milliseconds;
 
 constexpr auto kFirstFrameTimeout = milliseconds(30000);
-constexpr auto kEndTimeout = milliseconds(30000);
+constexpr auto kAbuseEndTimeout = milliseconds(30000);
 
 // The /metrics lines the report shows.
 const std::vector<std::string> kCounters = {
@@ -68,7 +68,7 @@ ParticipantRun participant(const test::ManagerUnderTest& manager, const std::str
   if (!token.empty()) {
     try {
       if (const auto row = manager.row_for_token(token); row && is_live_state(row->state)) end_session(manager, row->id);
-      wait_for_row(manager, token, [](const test::IndexRow& x) { return !is_live_state(x.state); }, kEndTimeout,
+      wait_for_row(manager, token, [](const test::IndexRow& x) { return !is_live_state(x.state); }, kAbuseEndTimeout,
                    "ended");
     } catch (const std::exception& error) {
       if (run.error.empty()) run.error = error.what();
@@ -99,7 +99,7 @@ void end_storm_sessions(const test::ManagerUnderTest& manager) {
     } catch (const std::exception&) {
       // It ended by itself between the look and the request.
     }
-    wait_for_row(manager, row.token, [](const test::IndexRow& x) { return !is_live_state(x.state); }, kEndTimeout,
+    wait_for_row(manager, row.token, [](const test::IndexRow& x) { return !is_live_state(x.state); }, kAbuseEndTimeout,
                  "ended");
   }
 }

@@ -25,7 +25,7 @@ namespace {
 using std::chrono::milliseconds;
 
 constexpr auto kReadyTimeout = milliseconds(30000);  // /start to the first update
-constexpr auto kEndTimeout = milliseconds(30000);    // admin end to a final state
+constexpr auto kSoakEndTimeout = milliseconds(30000);    // admin end to a final state
 constexpr std::size_t kKeptErrors = 5;
 
 // What the workers share with the scheduler.
@@ -70,7 +70,7 @@ void soak_session(const test::ManagerUnderTest& manager, const std::string& scen
     const test::IndexRow row = wait_for_row(
         manager, token, [](const test::IndexRow& x) { return !x.ready_at.empty(); }, kReadyTimeout, "became ready");
     if (!leave_to_idle) end_session(manager, row.id);
-    const auto end_timeout = kEndTimeout + (leave_to_idle ? std::chrono::seconds(kSoakIdleTimeoutS) : milliseconds(0));
+    const auto end_timeout = kSoakEndTimeout + (leave_to_idle ? std::chrono::seconds(kSoakIdleTimeoutS) : milliseconds(0));
     const test::IndexRow last = wait_for_row(
         manager, token, [](const test::IndexRow& x) { return !is_live_state(x.state); }, end_timeout, "ended");
     const std::lock_guard lock(tally.mutex);
