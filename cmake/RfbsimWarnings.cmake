@@ -6,6 +6,6 @@ function(rfbsim_warnings target)
     -Wcast-align -Woverloaded-virtual -Wconversion -Wsign-conversion -Wnull-dereference
     -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough
     # In a unity batch a .cpp is included, not the main file, so GCC takes a pimpl's fields of file-local types
-    # for a header's and warns; built alone the same file is clean.
-    $<$<BOOL:$<TARGET_PROPERTY:${target},UNITY_BUILD>>:-Wno-subobject-linkage>)
+    # for a header's and warns; built alone the same file is clean. (GCC's C++ warning only.)
+    $<$<AND:$<CXX_COMPILER_ID:GNU>,$<COMPILE_LANGUAGE:CXX>,$<BOOL:$<TARGET_PROPERTY:${target},UNITY_BUILD>>>:-Wno-subobject-linkage>)
 endfunction()
