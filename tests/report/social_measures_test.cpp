@@ -85,6 +85,20 @@ void write_robot_social_sessions(const std::filesystem::path& data) {
   write_session(data / "2-passers", passers_by_session());
 }
 
+// summary.csv's "all sessions" row over the approach and passers-by sessions: each statistic over the sessions
+// that have a value (one intrusion in two sessions; one closing-in distance, 1.0 m).
+void check_robot_social_summary(const std::filesystem::path& out) {
+  const auto groups = csv_records(read_text(out / "summary.csv"));
+  REQUIRE_FALSE(groups.empty());
+  const auto& all = groups[0];
+  CHECK(all.at("robot_caused_personal_intrusions_n") == "2");
+  CHECK(std::stod(all.at("robot_caused_personal_intrusions_mean")) == Approx(0.5));
+  CHECK(all.at("robot_min_distance_moving_toward_n") == "1");
+  CHECK(std::stod(all.at("robot_min_distance_moving_toward_median")) == Approx(1.0));
+  CHECK(std::stod(all.at("robot_intrusion_share_mean")) == Approx(50.0));
+  CHECK(std::stod(all.at("pct_robot_caused_intimate")) == Approx(0.0));
+}
+
 const Rate& rate(const std::string& name) {
   for (const Rate& r : summary_rates()) {
     if (r.name == name) return r;
@@ -241,15 +255,7 @@ TEST_CASE("sessions.csv and summary.csv carry the social measures") {
   CHECK(rows[1].at("robot_min_distance_moving_toward").empty());
 
   // The group's statistics are over the sessions with a value.
-  const auto groups = csv_records(read_text(out / "summary.csv"));
-  REQUIRE_FALSE(groups.empty());
-  const auto& all = groups[0];
-  CHECK(all.at("robot_caused_personal_intrusions_n") == "2");
-  CHECK(std::stod(all.at("robot_caused_personal_intrusions_mean")) == Approx(0.5));
-  CHECK(all.at("robot_min_distance_moving_toward_n") == "1");
-  CHECK(std::stod(all.at("robot_min_distance_moving_toward_median")) == Approx(1.0));
-  CHECK(std::stod(all.at("robot_intrusion_share_mean")) == Approx(50.0));
-  CHECK(std::stod(all.at("pct_robot_caused_intimate")) == Approx(0.0));
+  check_robot_social_summary(out);
 }
 
 TEST_CASE("sessions without a robot add no zeros to sessions.csv or summary.csv") {
@@ -272,13 +278,5 @@ TEST_CASE("sessions without a robot add no zeros to sessions.csv or summary.csv"
   }
 
   // The group's statistics are over the sessions with a value: the lone avatar's empties are not zeros.
-  const auto groups = csv_records(read_text(out / "summary.csv"));
-  REQUIRE_FALSE(groups.empty());
-  const auto& all = groups[0];
-  CHECK(all.at("robot_caused_personal_intrusions_n") == "2");
-  CHECK(std::stod(all.at("robot_caused_personal_intrusions_mean")) == Approx(0.5));
-  CHECK(all.at("robot_min_distance_moving_toward_n") == "1");
-  CHECK(std::stod(all.at("robot_min_distance_moving_toward_median")) == Approx(1.0));
-  CHECK(std::stod(all.at("robot_intrusion_share_mean")) == Approx(50.0));
-  CHECK(std::stod(all.at("pct_robot_caused_intimate")) == Approx(0.0));
+  check_robot_social_summary(out);
 }

@@ -44,6 +44,31 @@ std::optional<ProcStat> read_proc_stat(pid_t pid) {
   return stat;
 }
 
+// A TCP socket in LISTEN state: its local port and its inode (how /proc/*/fd names it).
+struct ListeningSocket {
+  int port = 0;
+  std::string inode;
+};
+
+// Every listening TCP socket on this machine, IPv4 and IPv6 (/proc/net/tcp's columns: slot, local and remote
+// address, state, queues, timer, retransmits, uid, timeout, inode).
+std::vector<ListeningSocket> listening_sockets() {
+  std::vector<ListeningSocket> sockets;
+  for (const char* file : {"/proc/net/tcp", "/proc/net/tcp6"}) {
+    std::ifstream table(file);
+    std::string line;
+    std::getline(table, line);  // header
+    while (std::getline(table, line)) {
+      std::istringstream fields(line);
+      std::string slot, local, remote, state, queues, timer, retransmits, uid, timeout, inode;
+      fields >> slot >> local >> remote >> state >> queues >> timer >> retransmits >> uid >> timeout >> inode;
+      if (state != "0A") continue;  // TCP_LISTEN
+      sockets.push_back({std::stoi(local.substr(local.find(':') + 1), nullptr, 16), inode});
+    }
+  }
+  return sockets;
+}
+
 // Every process /proc lists now (one that exits while the list is read is left out).
 std::vector<ProcStat> all_processes() {
   std::vector<ProcStat> out;
@@ -309,18 +334,8 @@ bool group_has_running_member(pid_t pgid) {
 std::vector<pid_t> listener_groups(int port) {
   // The sockets' inodes, then the processes holding a descriptor of one.
   std::vector<std::string> inodes;
-  for (const char* file : {"/proc/net/tcp", "/proc/net/tcp6"}) {
-    std::ifstream table(file);
-    std::string line;
-    std::getline(table, line);  // header
-    while (std::getline(table, line)) {
-      std::istringstream fields(line);
-      std::string slot, local, remote, state, queues, timer, retransmits, uid, timeout, inode;
-      fields >> slot >> local >> remote >> state >> queues >> timer >> retransmits >> uid >> timeout >> inode;
-      if (state == "0A" && std::stoi(local.substr(local.find(':') + 1), nullptr, 16) == port) {
-        inodes.push_back("socket:[" + inode + "]");
-      }
-    }
+  for (const ListeningSocket& socket : listening_sockets()) {
+    if (socket.port == port) inodes.push_back("socket:[" + socket.inode + "]");
   }
   std::vector<pid_t> groups;
   if (inodes.empty()) return groups;
@@ -337,18 +352,7 @@ std::vector<pid_t> listener_groups(int port) {
 
 std::vector<int> listening_ports() {
   std::vector<int> ports;
-  for (const char* file : {"/proc/net/tcp", "/proc/net/tcp6"}) {
-    std::ifstream table(file);
-    std::string line;
-    std::getline(table, line);  // header
-    while (std::getline(table, line)) {
-      std::istringstream fields(line);
-      std::string slot, local, remote, state;
-      fields >> slot >> local >> remote >> state;
-      if (state != "0A") continue;  // TCP_LISTEN
-      ports.push_back(std::stoi(local.substr(local.find(':') + 1), nullptr, 16));
-    }
-  }
+  for (const ListeningSocket& socket : listening_sockets()) ports.push_back(socket.port);
   return ports;
 }
 

@@ -17,9 +17,10 @@ inline void put_u16_clamped(std::vector<std::uint8_t>& out, int value) {
   out.push_back(static_cast<std::uint8_t>(v));
 }
 
-/// EnableContinuousUpdates (150): U8 enable, U16 x, y, w, h, for the whole width x height framebuffer.
-inline std::vector<std::uint8_t> enable_continuous_message(bool enable, int width, int height) {
-  std::vector<std::uint8_t> out{150, static_cast<std::uint8_t>(enable ? 1 : 0)};
+/// A message of `type` whose body is a U8 flag and an area, U16 x, y, w, h: here the whole width x height
+/// framebuffer.
+inline std::vector<std::uint8_t> whole_frame_message(std::uint8_t type, bool flag, int width, int height) {
+  std::vector<std::uint8_t> out{type, static_cast<std::uint8_t>(flag ? 1 : 0)};
   put_u16_clamped(out, 0);
   put_u16_clamped(out, 0);
   put_u16_clamped(out, width);
@@ -27,14 +28,14 @@ inline std::vector<std::uint8_t> enable_continuous_message(bool enable, int widt
   return out;
 }
 
-/// FramebufferUpdateRequest (3): U8 incremental, U16 x, y, w, h, for the whole width x height framebuffer.
+/// EnableContinuousUpdates (150): U8 enable, then the area.
+inline std::vector<std::uint8_t> enable_continuous_message(bool enable, int width, int height) {
+  return whole_frame_message(150, enable, width, height);
+}
+
+/// FramebufferUpdateRequest (3): U8 incremental, then the area.
 inline std::vector<std::uint8_t> update_request_message(bool incremental, int width, int height) {
-  std::vector<std::uint8_t> out{3, static_cast<std::uint8_t>(incremental ? 1 : 0)};
-  put_u16_clamped(out, 0);
-  put_u16_clamped(out, 0);
-  put_u16_clamped(out, width);
-  put_u16_clamped(out, height);
-  return out;
+  return whole_frame_message(3, incremental, width, height);
 }
 
 }  // namespace rfbsim::test

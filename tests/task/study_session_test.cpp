@@ -145,24 +145,31 @@ TEST_CASE("a scripted participant completes the tutorial, and the session data t
   CHECK(matched == end_tick / 6);
 }
 
-TEST_CASE("a participant who does nothing in the lab times out at the limit and gets the timeout code") {
-  SessionSetup setup;
+namespace {
+
+// Records into `dir` a lab session with a 3 s limit (and `setup`'s other settings) whose participant connects
+// at tick `connect_tick` and does nothing: it times out 180 ticks later. The session runs to its own end.
+void record_idle_lab_timeout(SessionSetup setup, const std::filesystem::path& dir, int connect_tick) {
   setup.scenario = "lab";
   setup.time_limit = 3.0;
   PreparedSession prepared = prepare_session(setup);
   Simulation& simulation = *prepared.simulation;
+  SessionWriter writer(dir, info_for(prepared, "p-idle"), simulation.world());
+  StudySession study(simulation, prepared.task, {"OK-1", "LATE-2"}, &writer);
+  for (int i = 0; i < connect_tick; ++i) study.step();
+  study.client_connected(1, "0123456789abcdef", true);  // the clock starts here
+  while (!study.over() && simulation.world().tick < 60 * 60) study.step();
+  REQUIRE(study.outcome() == TaskOutcome::Timeout);
+  CHECK(*study.task().outcome_tick() == static_cast<std::uint64_t>(connect_tick + 180));
+  study.finish("timeout");
+}
+
+}  // namespace
+
+TEST_CASE("a participant who does nothing in the lab times out at the limit and gets the timeout code") {
   ScratchDir scratch;
   const auto dir = scratch.path() / "lab_timeout";
-  {
-    SessionWriter writer(dir, info_for(prepared, "p-idle"), simulation.world());
-    StudySession study(simulation, prepared.task, {"OK-1", "LATE-2"}, &writer);
-    for (int i = 0; i < 30; ++i) study.step();
-    study.client_connected(1, "0123456789abcdef", true);  // the clock starts at tick 30
-    while (!study.over() && simulation.world().tick < 60 * 60) study.step();
-    REQUIRE(study.outcome() == TaskOutcome::Timeout);
-    CHECK(*study.task().outcome_tick() == 30 + 180);
-    study.finish("timeout");
-  }
+  record_idle_lab_timeout({}, dir, 30);
   const json session = read_json(dir / "session.json");
   CHECK(session["outcome"] == "timeout");
   CHECK(session["completion"]["code"] == "LATE-2");
@@ -181,22 +188,10 @@ TEST_CASE("a participant who does nothing in the lab times out at the limit and 
 
 TEST_CASE("an end grace given instead of the scenario's ends the session that much after the outcome, recorded") {
   SessionSetup setup;
-  setup.scenario = "lab";
-  setup.time_limit = 3.0;
   setup.end_grace = 2.0;
-  PreparedSession prepared = prepare_session(setup);
-  Simulation& simulation = *prepared.simulation;
   ScratchDir scratch;
   const auto dir = scratch.path() / "lab_short_grace";
-  {
-    SessionWriter writer(dir, info_for(prepared, "p-grace"), simulation.world());
-    StudySession study(simulation, prepared.task, {"OK-1", "LATE-2"}, &writer);
-    study.client_connected(1, "0123456789abcdef", true);  // the clock starts at tick 0
-    while (!study.over() && simulation.world().tick < 60 * 60) study.step();
-    REQUIRE(study.outcome() == TaskOutcome::Timeout);
-    CHECK(*study.task().outcome_tick() == 180);
-    study.finish("timeout");
-  }
+  record_idle_lab_timeout(setup, dir, 0);
   const json session = read_json(dir / "session.json");
   CHECK(session["end_grace_s"] == 2.0);
   CHECK(session["end_tick"] == 180 + 2 * 60);
