@@ -17,18 +17,18 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "agent_check.hpp"
-#include "config.hpp"
-#include "frontend.hpp"
-#include "link_signature.hpp"
-#include "metrics.hpp"
-#include "registry_client.hpp"
-#include "registry_server.hpp"
-#include "session_index.hpp"
-#include "start_request.hpp"
-#include "supervisor.hpp"
-#include "tokens.hpp"
-#include "uid_registry.hpp"
+#include "cluster/agent_check.hpp"
+#include "config/config.hpp"
+#include "http/frontend.hpp"
+#include "admission/link_signature.hpp"
+#include "admin/metrics.hpp"
+#include "cluster/registry_client.hpp"
+#include "cluster/registry_server.hpp"
+#include "sessions/session_index.hpp"
+#include "admission/start_request.hpp"
+#include "sessions/supervisor.hpp"
+#include "admission/tokens.hpp"
+#include "cluster/uid_registry.hpp"
 
 extern char** environ;
 

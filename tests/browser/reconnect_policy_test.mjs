@@ -21,7 +21,7 @@ const MIDDLE = () => 0.5;    // no jitter
 const HIGH = () => 0.999999; // the jitter's highest draw
 
 test('the closes sim_manager and sim_rfb send on purpose are endings, never reconnected', () => {
-  // manager/session_views.cpp close_notice: finished 1000, expired/idle/ended/shutdown 1001; sim_rfb: 1001.
+  // manager/sessions/session_views.cpp close_notice: finished 1000, expired/idle/ended/shutdown 1001; sim_rfb: 1001.
   for (const code of [1000, 1001]) {
     assert.equal(classifyClose({ connected: true, clean: true, code }), 'ended', `code ${code}`);
     assert.equal(classifyClose({ connected: false, clean: false, code }), 'ended', `code ${code}, not connected`);

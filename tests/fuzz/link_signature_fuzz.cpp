@@ -8,8 +8,8 @@
 #include <string>
 
 #include "fuzz_check.hpp"
-#include "link_signature.hpp"
-#include "query.hpp"
+#include "admission/link_signature.hpp"
+#include "http/query.hpp"
 
 using rfbsim::fuzz::check;
 using namespace rfbsim::manager;

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "fuzz_check.hpp"
-#include "query.hpp"
+#include "http/query.hpp"
 
 using rfbsim::fuzz::check;
 using namespace rfbsim::manager;

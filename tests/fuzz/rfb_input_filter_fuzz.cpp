@@ -6,7 +6,7 @@
 #include <string>
 
 #include "fuzz_check.hpp"
-#include "rfb_input_filter.hpp"
+#include "http/rfb_input_filter.hpp"
 
 using rfbsim::fuzz::check;
 using rfbsim::manager::RfbInputFilter;

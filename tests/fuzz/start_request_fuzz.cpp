@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "fuzz_check.hpp"
-#include "query.hpp"
-#include "start_request.hpp"
+#include "http/query.hpp"
+#include "admission/start_request.hpp"
 
 using rfbsim::fuzz::check;
 using namespace rfbsim::manager;

@@ -8,7 +8,7 @@
 #include <boost/asio/write.hpp>
 #include <thread>
 
-#include "agent_check.hpp"
+#include "cluster/agent_check.hpp"
 
 using rfbsim::manager::agent_status_line;
 using rfbsim::manager::AgentCheckServer;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // client_address: the participant's address behind trusted proxies, and address ranges.
-#include "client_address.hpp"
+#include "http/client_address.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -3,7 +3,7 @@
 
 #include <filesystem>
 
-#include "config.hpp"
+#include "config/config.hpp"
 #include "scratch_dir.hpp"
 
 using Catch::Contains;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // ConnectionLimits: per-address and total caps on open connections.
-#include "connection_limits.hpp"
+#include "http/connection_limits.hpp"
 
 #include <catch2/catch.hpp>
 

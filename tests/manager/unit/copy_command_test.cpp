@@ -3,8 +3,8 @@
 // schedule (5 s doubling up to 5 min).
 #include <catch2/catch.hpp>
 
-#include "config.hpp"
-#include "copy_command.hpp"
+#include "config/config.hpp"
+#include "sessions/copy_command.hpp"
 
 using rfbsim::manager::copy_backoff;
 using rfbsim::manager::copy_command_problem;

@@ -3,7 +3,7 @@
 // as flags and as keys, with the cluster's default prefix.
 #include <catch2/catch.hpp>
 
-#include "config.hpp"
+#include "config/config.hpp"
 #include "scratch_dir.hpp"
 
 using Catch::Contains;

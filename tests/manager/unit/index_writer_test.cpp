@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // IndexWriter: writes in order on its own thread, reports each, and leaves nothing unwritten at destruction.
-#include "index_writer.hpp"
+#include "sessions/index_writer.hpp"
 
 #include <catch2/catch.hpp>
 #include <filesystem>
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "scratch_dir.hpp"
-#include "session_index.hpp"
+#include "sessions/session_index.hpp"
 
 using rfbsim::manager::IndexWriter;
 using rfbsim::manager::Session;

@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "launch_plan.hpp"
+#include "sessions/launch_plan.hpp"
 
 using rfbsim::manager::LaunchContext;
 using rfbsim::manager::ManagerConfig;

@@ -4,7 +4,7 @@
 #include <cctype>
 #include <stdexcept>
 
-#include "link_signature.hpp"
+#include "admission/link_signature.hpp"
 
 using rfbsim::manager::canonical_link_text;
 using rfbsim::manager::hmac_sha256_hex;

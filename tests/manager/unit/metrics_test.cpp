@@ -3,7 +3,7 @@
 
 #include <sstream>
 
-#include "metrics.hpp"
+#include "admin/metrics.hpp"
 
 using rfbsim::manager::Metrics;
 using rfbsim::manager::Rejection;

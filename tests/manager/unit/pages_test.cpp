@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include <catch2/catch.hpp>
 
-#include "pages.hpp"
+#include "http/pages.hpp"
 
 using Catch::Contains;
 using rfbsim::manager::busy_page;

@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "process_launcher.hpp"
+#include "sessions/process_launcher.hpp"
 #include "reap_child.hpp"
 #include "scratch_dir.hpp"
 

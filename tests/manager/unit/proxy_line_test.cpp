@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include <catch2/catch.hpp>
 
-#include "proxy_line.hpp"
+#include "http/proxy_line.hpp"
 
 using boost::asio::ip::make_address;
 using boost::asio::ip::tcp;

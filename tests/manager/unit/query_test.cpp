@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include <catch2/catch.hpp>
 
-#include "query.hpp"
+#include "http/query.hpp"
 
 using rfbsim::manager::parse_query;
 using rfbsim::manager::percent_decode;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // RateLimiter: token buckets per address with a fake clock.
-#include "rate_limiter.hpp"
+#include "admission/rate_limiter.hpp"
 
 #include <catch2/catch.hpp>
 #include <string>

@@ -6,7 +6,7 @@
 #include <initializer_list>
 #include <string>
 
-#include "rfb_input_filter.hpp"
+#include "http/rfb_input_filter.hpp"
 
 using rfbsim::manager::RfbInputFilter;
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "ros_settings.hpp"
+#include "config/ros_settings.hpp"
 #include "scratch_dir.hpp"
 
 using rfbsim::manager::ca_file_problem;

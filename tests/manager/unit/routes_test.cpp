@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include <catch2/catch.hpp>
 
-#include "routes.hpp"
+#include "http/routes.hpp"
 
 using rfbsim::manager::is_token;
 using rfbsim::manager::route_request;

@@ -19,8 +19,8 @@
 
 #include "eventually.hpp"
 #include "scratch_dir.hpp"
-#include "session_copier.hpp"
-#include "session_index.hpp"
+#include "sessions/session_copier.hpp"
+#include "sessions/session_index.hpp"
 
 using rfbsim::manager::CopierSettings;
 using rfbsim::manager::copy_job_for;

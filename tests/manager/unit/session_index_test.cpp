@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "scratch_dir.hpp"
-#include "session_index.hpp"
+#include "sessions/session_index.hpp"
 
 using rfbsim::manager::iso_utc;
 using rfbsim::manager::parse_iso_utc;

@@ -25,7 +25,7 @@
 #include "reap_child.hpp"
 #include "scoped_env.hpp"
 #include "scratch_dir.hpp"
-#include "session_process.hpp"
+#include "sessions/session_process.hpp"
 
 using rfbsim::manager::kReadyFd;
 using rfbsim::manager::process_group_alive;

@@ -3,7 +3,7 @@
 
 #include <stdexcept>
 
-#include "session_table.hpp"
+#include "sessions/session_table.hpp"
 
 using rfbsim::manager::Session;
 using rfbsim::manager::SessionState;

@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "session.hpp"
+#include "sessions/session.hpp"
 
 using rfbsim::manager::admit;
 using rfbsim::manager::Admission;

@@ -2,8 +2,8 @@
 // How sessions are shown: close notices per state, the page's status poll and the admin API's JSON.
 #include <catch2/catch.hpp>
 
-#include "session_index.hpp"
-#include "session_views.hpp"
+#include "sessions/session_index.hpp"
+#include "sessions/session_views.hpp"
 
 using rfbsim::manager::close_notice;
 using rfbsim::manager::coming_state;

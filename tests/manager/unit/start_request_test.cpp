@@ -2,7 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include "scratch_dir.hpp"
-#include "start_request.hpp"
+#include "admission/start_request.hpp"
 
 using rfbsim::manager::is_identifier;
 using rfbsim::manager::is_pose;

@@ -2,7 +2,7 @@
 // sim_rfb's stream lines as the manager reads them: every key, unknown ones ignored, bad ones refused whole.
 #include <catch2/catch.hpp>
 
-#include "stream_report.hpp"
+#include "sessions/stream_report.hpp"
 
 using rfbsim::manager::is_stream_line;
 using rfbsim::manager::parse_stream_line;

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <set>
 
-#include "tokens.hpp"
+#include "admission/tokens.hpp"
 
 using rfbsim::manager::new_seed;
 using rfbsim::manager::new_session_token;

@@ -13,11 +13,11 @@
 
 #include <sqlite3.h>
 
-#include "config.hpp"
-#include "link_signature.hpp"
+#include "config/config.hpp"
+#include "admission/link_signature.hpp"
 #include "scratch_dir.hpp"
-#include "session_index.hpp"
-#include "uid_registry.hpp"
+#include "sessions/session_index.hpp"
+#include "cluster/uid_registry.hpp"
 
 using rfbsim::manager::acceptor_accept;
 using rfbsim::manager::acceptor_answer;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include <catch2/catch.hpp>
 
-#include "web_policy.hpp"
+#include "http/web_policy.hpp"
 
 using rfbsim::manager::admin_authorized;
 using rfbsim::manager::Headers;

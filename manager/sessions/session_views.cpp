@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
+// Sessions as browsers and the admin API see them.
+#include "sessions/session_views.hpp"
+
+#include <cstdio>
+
+#include "sessions/session_index.hpp"
+#include "http/web_policy.hpp"
+
+namespace rfbsim::manager {
+
+CloseNotice close_notice(SessionState state) {
+  // 1000 normal closure, 1001 going away (the page shows these as an ending), 1011 an error on our side.
+  switch (state) {
+    case SessionState::kFinished: return {1000, "session finished"};
+    case SessionState::kExpired: return {1001, "session expired"};
+    case SessionState::kIdle: return {1001, "session ended after being idle"};
+    case SessionState::kEnded: return {1001, "session ended by the researcher"};
+    case SessionState::kShutdown: return {1001, "server shutting down"};
+    case SessionState::kFailed: return {1011, "the simulator could not start"};
+    default: return {1011, "the simulator stopped unexpectedly"};
+  }
+}
+
+std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins,
+                        const std::string& program) {
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%.3f", std::chrono::duration<double>(now - session.created).count());
+  const auto quoted = [](const std::string& text) { return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\""; };
+  const std::string& code = session.outcome == "completed" ? session.code_success
+                            : session.outcome == "timeout" ? session.code_timeout
+                                                           : session.outcome;  // empty without an outcome
+  std::string origins;
+  for (const std::string& origin : survey_origins) origins += (origins.empty() ? "\"" : ",\"") + json_escape(origin) + "\"";
+  return std::string("{\"state\":\"") + state_name(session.state) + "\",\"ends_as\":\"" +
+         state_name(coming_state(session)) + "\",\"elapsed_s\":" + seconds + ",\"uid\":\"" + json_escape(session.uid) +
+         "\",\"outcome\":" + quoted(session.outcome) + ",\"code\":" + quoted(code) + ",\"survey_origins\":[" +
+         origins + "]" + (program == "sim_rfb" ? std::string() : ",\"program\":\"" + json_escape(program) + "\"") +
+         "}";
+}
+
+std::string session_json(const Session& s, bool include_token) {
+  const auto text_or_null = [](const std::string& text) {
+    return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\"";
+  };
+  const auto time = [](const std::optional<WallTime>& t) { return t ? "\"" + iso_utc(*t) + "\"" : std::string("null"); };
+  std::string json = "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"scenario\":\"" +
+                     json_escape(s.scenario) + "\",\"seed\":\"" + std::to_string(s.seed) + "\",\"state\":\"" +
+                     state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"exit_status\":\"" +
+                     json_escape(s.exit_status) + "\",\"created_at\":\"" + iso_utc(s.created) +
+                     "\",\"ready_at\":" + time(s.ready_at) + ",\"ended_at\":" + time(s.ended_at) +
+                     ",\"data_path\":\"" + json_escape(s.data_path) + "\",\"outcome\":" +
+                     (s.outcome.empty() ? std::string("null") : "\"" + json_escape(s.outcome) + "\"") +
+                     ",\"copy_state\":\"" + json_escape(s.copy_state) + "\",\"copy_attempts\":" +
+                     std::to_string(s.copy_attempts) + ",\"copy_error\":\"" + json_escape(s.copy_error) +
+                     "\",\"params\":" + (s.params_json.empty() ? "{}" : s.params_json) +
+                     ",\"ros_namespace\":" + text_or_null(s.ros_namespace) +
+                     ",\"robot_control\":" + text_or_null(s.robot_control);
+  // The stream as sim_rfb last told it; null for what it did not say and when nobody watches.
+  const auto decimal = [](const std::optional<double>& value) {
+    if (!value) return std::string("null");
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", *value);
+    return std::string(text);
+  };
+  const bool watched = s.stream && s.stream->clients > 0;
+  json += std::string(",\"codec\":") +
+          (watched && !s.stream->codec.empty() ? "\"" + json_escape(s.stream->codec) + "\"" : std::string("null")) +
+          ",\"rtt_ms\":" + decimal(watched ? s.stream->rtt_ms : std::nullopt) +
+          ",\"fps\":" + decimal(watched ? s.stream->fps : std::nullopt);
+  if (include_token) json += ",\"token\":\"" + s.token + "\"";
+  return json + "}";
+}
+
+std::string session_record_json(const Session& s) {
+  const auto time = [](const std::optional<WallTime>& t) { return t ? "\"" + iso_utc(*t) + "\"" : std::string("null"); };
+  const auto text_or_null = [](const std::string& text) {
+    return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\"";
+  };
+  return "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"host\":\"" +
+         json_escape(s.host_id) + "\",\"address_hash\":" + text_or_null(s.address_hash) + ",\"state\":\"" +
+         state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"created_at\":\"" + iso_utc(s.created) +
+         "\",\"ready_at\":" + time(s.ready_at) + ",\"spent_at\":" + time(s.spent_at) + ",\"ended_at\":" +
+         time(s.ended_at) + ",\"outcome\":" + text_or_null(s.outcome) +
+         ",\"data_incomplete\":" + text_or_null(s.data_incomplete) + ",\"ros_namespace\":" +
+         text_or_null(s.ros_namespace) + ",\"robot_control\":" + text_or_null(s.robot_control) + "}\n";
+}
+
+}  // namespace rfbsim::manager
