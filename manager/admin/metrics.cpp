@@ -157,4 +157,12 @@ std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions
   return out;
 }
 
+std::vector<SessionStream> live_streams(const std::vector<Session*>& live) {
+  std::vector<SessionStream> streams;
+  for (const Session* session : live) {
+    if (session->stream) streams.push_back({session->id, *session->stream});
+  }
+  return streams;
+}
+
 }  // namespace rfbsim::manager

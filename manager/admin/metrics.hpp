@@ -53,6 +53,9 @@ struct SessionStream {
   StreamReport report;  ///< sim_rfb's latest; sessions nobody watches (clients 0) get no series
 };
 
+/// The live sessions' streams as sim_rfb last reported them (those that reported one), for the gauges.
+std::vector<SessionStream> live_streams(const std::vector<Session*>& live);
+
 /// Counters since the manager started; the session gauges are read from the table when rendered.
 class Metrics {
  public:

@@ -39,39 +39,6 @@ std::string status_json(const Session& session, WallTime now, const std::vector<
          "}";
 }
 
-std::string session_json(const Session& s, bool include_token) {
-  const auto text_or_null = [](const std::string& text) {
-    return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\"";
-  };
-  const auto time = [](const std::optional<WallTime>& t) { return t ? "\"" + iso_utc(*t) + "\"" : std::string("null"); };
-  std::string json = "{\"id\":" + std::to_string(s.id) + ",\"uid\":\"" + json_escape(s.uid) + "\",\"scenario\":\"" +
-                     json_escape(s.scenario) + "\",\"seed\":\"" + std::to_string(s.seed) + "\",\"state\":\"" +
-                     state_name(s.state) + "\",\"detail\":\"" + json_escape(s.detail) + "\",\"exit_status\":\"" +
-                     json_escape(s.exit_status) + "\",\"created_at\":\"" + iso_utc(s.created) +
-                     "\",\"ready_at\":" + time(s.ready_at) + ",\"ended_at\":" + time(s.ended_at) +
-                     ",\"data_path\":\"" + json_escape(s.data_path) + "\",\"outcome\":" +
-                     (s.outcome.empty() ? std::string("null") : "\"" + json_escape(s.outcome) + "\"") +
-                     ",\"copy_state\":\"" + json_escape(s.copy_state) + "\",\"copy_attempts\":" +
-                     std::to_string(s.copy_attempts) + ",\"copy_error\":\"" + json_escape(s.copy_error) +
-                     "\",\"params\":" + (s.params_json.empty() ? "{}" : s.params_json) +
-                     ",\"ros_namespace\":" + text_or_null(s.ros_namespace) +
-                     ",\"robot_control\":" + text_or_null(s.robot_control);
-  // The stream as sim_rfb last told it; null for what it did not say and when nobody watches.
-  const auto decimal = [](const std::optional<double>& value) {
-    if (!value) return std::string("null");
-    char text[32];
-    std::snprintf(text, sizeof text, "%.1f", *value);
-    return std::string(text);
-  };
-  const bool watched = s.stream && s.stream->clients > 0;
-  json += std::string(",\"codec\":") +
-          (watched && !s.stream->codec.empty() ? "\"" + json_escape(s.stream->codec) + "\"" : std::string("null")) +
-          ",\"rtt_ms\":" + decimal(watched ? s.stream->rtt_ms : std::nullopt) +
-          ",\"fps\":" + decimal(watched ? s.stream->fps : std::nullopt);
-  if (include_token) json += ",\"token\":\"" + s.token + "\"";
-  return json + "}";
-}
-
 std::string session_record_json(const Session& s) {
   const auto time = [](const std::optional<WallTime>& t) { return t ? "\"" + iso_utc(*t) + "\"" : std::string("null"); };
   const auto text_or_null = [](const std::string& text) {

@@ -27,14 +27,6 @@ CloseNotice close_notice(SessionState state);
 std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins,
                         const std::string& program = "sim_rfb");
 
-/// One session for the admin API: id, uid, scenario, seed, state, detail, exit status, times, data path, the
-/// after-session copy ("copy_state": "" | "pending" | "done" | "failed", "copy_attempts", "copy_error"), the
-/// link's parameters, the session's ROS ("ros_namespace", "robot_control": text or null), and the participant's
-/// stream: "codec" ("tight", "h264"), "rtt_ms" (1 decimal) and "fps"
-/// (1 decimal), each null when unknown or nobody watches; the token only when `include_token` (live sessions,
-/// which a researcher may watch).
-std::string session_json(const Session& session, bool include_token);
-
 /// The manager's record of a session, written beside the session's own data as manager.json so that the
 /// study's tools (sim_report) see how each session ended without the index: {"id", "uid", "host",
 /// "address_hash", "state", "detail", "created_at", "ready_at", "spent_at", "ended_at", "outcome",

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "sessions/session_index.hpp"
+#include "admin/admin_api.hpp"
 #include "sessions/session_views.hpp"
 
 using rfbsim::manager::close_notice;
@@ -99,14 +100,14 @@ TEST_CASE("the admin API's session JSON names every field, and the token only wh
       R"("copy_state":"","copy_attempts":0,"copy_error":"",)"
       R"("params":{"uid":"p-01","scenario":"lab","seed":"42"},"ros_namespace":null,"robot_control":null,)"
       R"("codec":null,"rtt_ms":null,"fps":null)";
-  CHECK(rfbsim::manager::session_json(s, false) == expected + "}");
-  CHECK(rfbsim::manager::session_json(s, true) == expected + R"(,"token":"0123456789abcdef0123456789abcdef"})");
+  CHECK(rfbsim::manager::admin_session_json(s, false) == expected + "}");
+  CHECK(rfbsim::manager::admin_session_json(s, true) == expected + R"(,"token":"0123456789abcdef0123456789abcdef"})");
 }
 
 TEST_CASE("the admin API's session JSON carries the participant's stream while someone watches") {
   Session s = sample();
   const auto stream_part = [&] {
-    const std::string json = rfbsim::manager::session_json(s, false);
+    const std::string json = rfbsim::manager::admin_session_json(s, false);
     return json.substr(json.find(R"("codec")"));
   };
   CHECK(stream_part() == R"("codec":null,"rtt_ms":null,"fps":null})");
@@ -151,7 +152,7 @@ TEST_CASE("the researcher sees a session's ROS namespace and robot control, the 
   Session s = sample();
   s.ros_namespace = "/rfbsim/s_7";
   s.robot_control = "external";
-  const std::string admin = rfbsim::manager::session_json(s, false);
+  const std::string admin = rfbsim::manager::admin_session_json(s, false);
   CHECK(admin.find(R"("ros_namespace":"/rfbsim/s_7","robot_control":"external",)") != std::string::npos);
   CHECK(rfbsim::manager::session_record_json(s).find(R"("ros_namespace":"/rfbsim/s_7","robot_control":"external"})") !=
         std::string::npos);
@@ -163,6 +164,6 @@ TEST_CASE("the researcher sees a session's ROS namespace and robot control, the 
   // A robot driven by the simulator, no ROS.
   s.ros_namespace.clear();
   s.robot_control = "builtin";
-  CHECK(rfbsim::manager::session_json(s, false).find(R"("ros_namespace":null,"robot_control":"builtin",)") !=
+  CHECK(rfbsim::manager::admin_session_json(s, false).find(R"("ros_namespace":null,"robot_control":"builtin",)") !=
         std::string::npos);
 }
