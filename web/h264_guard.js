@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Keeps one undecodable H.264 picture from freezing the participant page: watches the WebCodecs decoders that
-// noVNC makes and tells the page when one of them has failed, so that the page can reconnect (app.js).
+// noVNC makes and tells the page when one of them has failed, so that the page can reconnect
+// (picture_recovery.js).
 //
 // Why this is needed: noVNC 1.7 (core/decoders/h264.js) turns every H.264 rectangle into a "pending frame" that
 // only the decoder's output callback resolves, and its display queue draws nothing else, and reads no further
@@ -20,9 +21,10 @@
 // comes near that (one picture decodes in milliseconds).
 //
 // Install it before noVNC makes its first decoder (noVNC makes them when the first H.264 rectangle arrives, from the
-// global VideoDecoder). noVNC's own support check runs when its modules load, before app.js runs, so it keeps the
-// browser's class. Where VideoDecoder does not exist (an insecure context: http other than localhost, or an older
-// browser) nothing is installed: noVNC does not offer H.264 there and the page stays on JPEG.
+// global VideoDecoder). noVNC's own support check runs when its modules load, before picture_recovery.js installs
+// the guard, so it keeps the browser's class. Where VideoDecoder does not exist (an insecure context: http other
+// than localhost, or an older browser) nothing is installed: noVNC does not offer H.264 there and the page stays on
+// JPEG.
 
 const STALL_MS = 2000;   // a chunk without its decoded frame for this long counts as a failure
 const CHECK_MS = 500;    // how often decoders with chunks in flight are looked at

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // When the participant page connects again by itself: what a closed connection means, what to do about it given
 // what the manager says of the session, and how long to wait before the next try. Pure (no DOM, no timers, the
-// random source passed in) so that node:test runs it as it is (tests/browser/reconnect_policy_test.mjs); app.js
-// does the connecting and the showing.
+// random source passed in) so that node:test runs it as it is (tests/browser/reconnect_policy_test.mjs);
+// connection.js and reconnect.js do the connecting, page_view.js the showing.
 //
 // The rule: a connection that was lost (the network, a relay, a proxy dropped it) is tried again, with growing
 // waits and jitter, for as long as the manager says the session is alive, or cannot be asked (the network is the

@@ -1,9 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// RosbridgeHub: topics, subscriptions with rosbridge's throttle and queue semantics, bounded queues, all
-// behind one mutex. Subscription semantics follow rosbridge_suite's ROSBRIDGE_PROTOCOL.md ("subscribe"):
-// throttle_rate is the least time in ms between two messages; queue_length messages wait out the throttle,
-// the oldest replaced when full; several subscriptions to one topic send at the lowest throttle_rate and the
-// highest queue_length.
+// RosbridgeHub: topics, connections with their subscriptions, bounded queues, all behind one mutex. Each
+// subscription's throttle and queue semantics (rosbridge_suite's ROSBRIDGE_PROTOCOL.md, "subscribe") are
+// TopicSubscription's (topic_subscription.hpp); the hub decides who gets a message and queues what is due.
 #include "ros/bridge/rosbridge_hub.hpp"
 
 #include <algorithm>
@@ -13,24 +11,6 @@
 #include <utility>
 
 namespace rfbsim::ros {
-
-struct RosbridgeHub::Subscription {
-  std::map<std::string, SubscribeOptions> by_id;  // "" for subscriptions without an id
-  int throttle_ms = 0;                            // merged over by_id
-  int queue_length = 0;
-  std::optional<Clock::time_point> last_sent;
-  std::deque<Frame> pending;  // held back by the throttle, at most queue_length
-
-  void merge() {
-    throttle_ms = by_id.begin()->second.throttle_ms;
-    queue_length = 0;
-    for (const auto& [id, options] : by_id) {
-      throttle_ms = std::min(throttle_ms, options.throttle_ms);
-      queue_length = std::max(queue_length, options.queue_length);
-    }
-    while (pending.size() > static_cast<std::size_t>(queue_length)) pending.pop_front();
-  }
-};
 
 struct RosbridgeHub::Connection {
   explicit Connection(HubConnectionOptions options)
@@ -45,8 +25,8 @@ struct RosbridgeHub::Connection {
   // Default "warning", where rosbridge_suite mutes warnings: our warnings say when an option is not
   // honoured (compression) or a command is ignored, which a lab wants to see unasked.
   StatusLevel level = StatusLevel::kWarning;
-  std::map<std::string, Subscription> subscriptions;  // by topic
-  std::size_t subscription_ids = 0;                    // by_id entries over all topics
+  std::map<std::string, TopicSubscription> subscriptions;  // by topic
+  std::size_t subscription_ids = 0;                        // by_id entries over all topics
 };
 
 std::string_view status_level_name(StatusLevel level) {
@@ -195,8 +175,12 @@ void RosbridgeHub::publish(const std::string& topic, nlohmann::json msg) {
         enqueue(*connection, frame);
         continue;
       }
+      // Out now, or held back (or dropped) by the subscription's throttle.
       const auto subscription = connection->subscriptions.find(topic);
-      if (subscription != connection->subscriptions.end()) deliver(*connection, subscription->second, frame, now);
+      if (subscription != connection->subscriptions.end() &&
+          subscription->second.offer(frame, now, stats_.throttled_frames)) {
+        enqueue(*connection, frame);
+      }
     }
   }
   // Each tick's publishes also release what other topics' throttles held back.
@@ -293,7 +277,7 @@ std::string RosbridgeHub::subscribe(int connection, const std::string& topic, co
   if (new_id && found->subscription_ids >= kMaxSubscriptions) {
     return "already " + std::to_string(kMaxSubscriptions) + " subscriptions on this connection";
   }
-  Subscription& subscription = found->subscriptions[topic];
+  TopicSubscription& subscription = found->subscriptions[topic];
   subscription.by_id[options.id] = options;
   if (new_id) ++found->subscription_ids;
   subscription.merge();
@@ -453,26 +437,6 @@ RosbridgeHubStats RosbridgeHub::stats() const {
 
 // --- Private, called with mutex_ held ---
 
-void RosbridgeHub::deliver(Connection& connection, Subscription& subscription, const Frame& frame,
-                           Clock::time_point now) {
-  const auto throttle = std::chrono::milliseconds(subscription.throttle_ms);
-  const bool due = !subscription.last_sent || now - *subscription.last_sent >= throttle;
-  if (subscription.throttle_ms == 0 || (due && subscription.pending.empty())) {
-    subscription.last_sent = now;
-    enqueue(connection, frame);
-    return;
-  }
-  if (subscription.queue_length == 0) {
-    ++stats_.throttled_frames;
-    return;
-  }
-  subscription.pending.push_back(frame);
-  if (subscription.pending.size() > static_cast<std::size_t>(subscription.queue_length)) {
-    subscription.pending.pop_front();
-    ++stats_.throttled_frames;
-  }
-}
-
 std::string RosbridgeHub::status_text(StatusLevel level, const std::string& text, const nlohmann::json& id) {
   nlohmann::json status = {{"op", "status"},
                             {"level", status_level_name(level)},
@@ -489,17 +453,10 @@ std::optional<RosbridgeHub::Clock::time_point> RosbridgeHub::flush_due_locked(Cl
   std::optional<Clock::time_point> next;
   for (auto& [id, connection] : connections_) {
     for (auto& [topic, subscription] : connection->subscriptions) {
-      if (subscription.pending.empty()) continue;
-      const auto throttle = std::chrono::milliseconds(subscription.throttle_ms);
-      if (!subscription.last_sent || now - *subscription.last_sent >= throttle) {
-        subscription.last_sent = now;
-        enqueue(*connection, subscription.pending.front());
-        subscription.pending.pop_front();
-      }
-      if (!subscription.pending.empty()) {
-        const Clock::time_point due = *subscription.last_sent + throttle;
-        if (!next || due < *next) next = due;
-      }
+      // At most one held-back message per subscription and call: the throttle starts again with it.
+      if (Frame frame = subscription.take_due(now)) enqueue(*connection, std::move(frame));
+      const std::optional<Clock::time_point> due = subscription.next_due();
+      if (due && (!next || *due < *next)) next = due;
     }
   }
   return next;

@@ -28,6 +28,7 @@
 
 #include "ros/bridge/outbound_queue.hpp"
 #include "ros/bridge/ros_names.hpp"
+#include "ros/bridge/topic_subscription.hpp"
 
 namespace rfbsim::ros {
 
@@ -48,13 +49,6 @@ enum class StatusLevel { kInfo = 0, kWarning = 1, kError = 2, kNone = 3 };
 std::string_view status_level_name(StatusLevel level);
 /// The level a wire name names; nullopt for any other text.
 std::optional<StatusLevel> parse_status_level(std::string_view name);
-
-/// One subscription's options, as a subscribe op gave them (already validated).
-struct SubscribeOptions {
-  std::string id;         ///< the op's id ("" when none); unsubscribe by id removes only this one
-  int throttle_ms = 0;    ///< least time between two messages sent, ms (0: every message)
-  int queue_length = 0;   ///< messages held back by the throttle (0: a throttled message is dropped)
-};
 
 /// How the network side opens a hub connection.
 struct HubConnectionOptions {
@@ -218,11 +212,9 @@ class RosbridgeHub {
   static constexpr const char* kClockTopic = "/clock";
 
  private:
-  struct Subscription;
   struct Connection;
   struct Topic;
 
-  void deliver(Connection& connection, Subscription& subscription, const Frame& frame, Clock::time_point now);
   void enqueue(Connection& connection, Frame frame);
   [[nodiscard]] static std::string status_text(StatusLevel level, const std::string& text, const nlohmann::json& id);
   std::optional<Clock::time_point> flush_due_locked(Clock::time_point now);
