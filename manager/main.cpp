@@ -29,6 +29,7 @@
 #include "sessions/supervisor.hpp"
 #include "admission/tokens.hpp"
 #include "cluster/uid_registry.hpp"
+#include "rfbsim/log.hpp"
 
 extern char** environ;
 
@@ -139,11 +140,11 @@ void learn_scenarios(ManagerConfig& config) {
   config.scenario_facts = manager::load_scenario_facts(config.scenarios, scenario_search_dirs(), error, missing);
   if (!error.empty()) throw std::runtime_error(error);
   for (const std::string& entry : missing) {
-    std::fprintf(stderr, "[manager] warning: scenario %s: no file found where sim_rfb looks by name; its links' spawn "
-                 "names are left to sim_rfb and max_duration_s is not fitted to its task\n", entry.c_str());
+    rfbsim::log::warn("manager", "warning: scenario %s: no file found where sim_rfb looks by name; its links' spawn "
+                 "names are left to sim_rfb and max_duration_s is not fitted to its task", entry.c_str());
   }
   const std::string warning = manager::fit_max_duration(config);
-  if (!warning.empty()) std::fprintf(stderr, "[manager] warning: %s\n", warning.c_str());
+  if (!warning.empty()) rfbsim::log::warn("manager", "warning: %s", warning.c_str());
 }
 
 // How long the I/O thread's index reads wait for another connection's lock.
@@ -151,6 +152,8 @@ constexpr int kReaderBusyTimeoutMs = 100;
 
 int run(ManagerConfig config) {
   namespace manager = rfbsim::manager;
+  rfbsim::log::Level log_level = rfbsim::log::Level::kInfo;
+  if (rfbsim::log::parse_level(config.log_level, log_level)) rfbsim::log::set_level(log_level);
   const std::string program = config.session_kind == rfbsim::manager::SessionKind::kX11
                                   ? resolve_x11_session(config)
                                   : resolve_program(config.session_command);
@@ -175,7 +178,7 @@ int run(ManagerConfig config) {
   manager::Metrics metrics;
   manager::Supervisor supervisor(io, config, program, index, metrics);
   if (const int interrupted = supervisor.recover_interrupted(); interrupted > 0) {
-    std::fprintf(stderr, "[manager] marked %d session(s) left by the previous run as interrupted\n", interrupted);
+    rfbsim::log::info("manager", "marked %d session(s) left by the previous run as interrupted", interrupted);
   }
   // Before the first link: the index says what happened to the previous run's sessions.
   supervisor.flush_index();
@@ -195,23 +198,23 @@ int run(ManagerConfig config) {
         (std::filesystem::path(config.data_dir) / "sessions.db").string());
     registry_client =
         std::make_unique<manager::RegistryClient>(io, config.cluster_peers, config.host_id, key, *registry_server);
-    std::fprintf(stderr, "[manager] uid registry on %s:%d, host %s of %zu\n", registry_address.c_str(),
+    rfbsim::log::info("manager", "uid registry on %s:%d, host %s of %zu", registry_address.c_str(),
                  registry_server->port(), config.host_id.c_str(), config.cluster_peers.size());
     if (config.cluster_peers.size() % 2 == 0) {
-      std::fprintf(stderr,
-                   "[manager] warning: %zu cluster peers: a majority is %zu of them, so %zu down stop every new uid, "
-                   "as with %zu peers; an odd number is better (docs/architecture.md, \"uid registry\")\n",
+      rfbsim::log::warn("manager",
+                   "warning: %zu cluster peers: a majority is %zu of them, so %zu down stop every new uid, "
+                   "as with %zu peers; an odd number is better (docs/architecture.md, \"uid registry\")",
                    config.cluster_peers.size(), config.cluster_peers.size() / 2 + 1, config.cluster_peers.size() / 2,
                    config.cluster_peers.size() - 1);
     }
     // An acceptor that forgot what it promised or accepted can let a second home be decided: a host rebuilt
     // with an empty data folder must join under a new id (docs/architecture.md, "uid registry").
     if (index.registry_table_created()) {
-      std::fprintf(stderr,
-                   "[manager] WARNING: this host's uid registry records are new (sessions.db or its uid_acceptors "
+      rfbsim::log::warn("manager",
+                   "WARNING: this host's uid registry records are new (sessions.db or its uid_acceptors "
                    "table was just created). Fine on a cluster's first start. If this host ran before and lost its "
                    "sessions.db, stop it: it must rejoin under a new host_id, with every host restarted on the new "
-                   "cluster_peers list (docs/architecture.md, \"uid registry\")\n");
+                   "cluster_peers list (docs/architecture.md, \"uid registry\")");
     }
   }
   const auto frontend = manager::make_frontend(io, config, supervisor, metrics, web_root, registry_client.get());
@@ -225,14 +228,14 @@ int run(ManagerConfig config) {
       return manager::AgentLoad{config.max_sessions - live, config.max_sessions, supervisor.draining(),
                                 supervisor.shutting_down()};
     });
-    std::fprintf(stderr, "[manager] HAProxy agent-check on %s:%d\n", agent_address.c_str(), agent->port());
+    rfbsim::log::info("manager", "HAProxy agent-check on %s:%d", agent_address.c_str(), agent->port());
   }
   // Without signed links the uid is the only secret: anyone who learns or guesses one can start (or take
   // over) that participant's session. Fine on loopback; on a public address it should be a choice.
   if (config.link_secret.empty() && config.listen_address.rfind("127.", 0) != 0) {
-    std::fprintf(stderr,
-                 "[manager] warning: links are unsigned and the port listens on %s: anyone who knows a uid can start "
-                 "or take over its session; set link_secret (docs/security.md)\n",
+    rfbsim::log::warn("manager",
+                 "warning: links are unsigned and the port listens on %s: anyone who knows a uid can start "
+                 "or take over its session; set link_secret (docs/security.md)",
                  config.listen_address.c_str());
   }
 
@@ -242,7 +245,7 @@ int run(ManagerConfig config) {
   boost::asio::steady_timer last_words(io);
   stop_signals.async_wait([&](const boost::system::error_code& ec, int signal) {
     if (ec) return;
-    std::fprintf(stderr, "[manager] signal %d: ending %zu session(s)\n", signal, supervisor.table().size());
+    rfbsim::log::info("manager", "signal %d: ending %zu session(s)", signal, supervisor.table().size());
     frontend->stop();
     supervisor.shutdown([&] {
       last_words.expires_after(std::chrono::milliseconds(200));
@@ -256,7 +259,7 @@ int run(ManagerConfig config) {
   std::string example = "uid=demo";
   if (!config.scenarios.empty()) example += "&scenario=" + manager::scenario_names(config.scenarios).front();
   if (!config.link_secret.empty()) example = manager::sign_query(example, config.link_secret);
-  std::fprintf(stderr, "[manager] sessions: %s (%s), at most %d, %lld s each, idle timeout %lld s; data in %s\n",
+  rfbsim::log::info("manager", "sessions: %s (%s), at most %d, %lld s each, idle timeout %lld s; data in %s",
                (config.session_kind == manager::SessionKind::kX11 ? config.session_command : program).c_str(),
                manager::session_kind_name(config.session_kind), config.max_sessions,
                static_cast<long long>(config.max_duration.count()),
@@ -270,10 +273,11 @@ int run(ManagerConfig config) {
       io.run();
       break;
     } catch (const std::exception& error) {
-      std::fprintf(stderr, "[manager] error on the I/O loop: %s; carrying on\n", error.what());
+      rfbsim::log::warn("manager", "error on the I/O loop: %s; carrying on", error.what());
     }
   }
-  std::fprintf(stderr, "[manager] stopped\n");
+  rfbsim::log::flush_suppressed();  // what the rate limit held back is counted before the last line
+  rfbsim::log::info("manager", "stopped");
   return 0;
 }
 

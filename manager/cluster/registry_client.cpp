@@ -11,6 +11,7 @@
 
 #include "admission/tokens.hpp"
 #include "admission/unix_time.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -120,7 +121,7 @@ void RegistryClient::resolve(const std::shared_ptr<Remote>& remote) {
         if (!ec && !results.empty()) {
           const tcp::endpoint found = results.begin()->endpoint();
           if (remote->endpoint != found) {
-            std::fprintf(stderr, "[registry] peer %s: %s is %s\n", remote->peer.id.c_str(),
+            rfbsim::log::info("registry", "peer %s: %s is %s", remote->peer.id.c_str(),
                          remote->peer.address.c_str(), found.address().to_string().c_str());
           }
           remote->endpoint = found;
@@ -128,7 +129,7 @@ void RegistryClient::resolve(const std::shared_ptr<Remote>& remote) {
           return;
         }
         if (!remote->warned) {
-          std::fprintf(stderr, "[registry] peer %s: cannot resolve %s (%s); it counts as down until it does\n",
+          rfbsim::log::warn("registry", "peer %s: cannot resolve %s (%s); it counts as down until it does\n",
                        remote->peer.id.c_str(), remote->peer.address.c_str(), ec.message().c_str());
           remote->warned = true;
         }
@@ -154,7 +155,7 @@ void RegistryClient::learn(const std::string& uid, Learned done) {
 void RegistryClient::run_ballot(const std::shared_ptr<Round>& round) {
   ++round->attempt;
   if (counter_ >= kMaxBallotCounter) {
-    std::fprintf(stderr, "[registry] uid %s: ballot counters are used up\n", round->uid.c_str());
+    rfbsim::log::warn("registry", "uid %s: ballot counters are used up", round->uid.c_str());
     round->done(LearnResult{});
     return;
   }
@@ -210,7 +211,7 @@ void RegistryClient::ask(const std::shared_ptr<Phase>& phase, const std::shared_
     const MessageParse parsed = parse_message(line, key_);
     // A wrong answer is no vote: an error line, another secret or peer list, an answer to another question.
     if (!parsed.message || !answers_request(*parsed.message, exchange->request, peers_)) {
-      std::fprintf(stderr, "[registry] peer %s answered '%.80s'; not counted\n", id.c_str(), line.c_str());
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "registry-bad-answer", "registry", "peer %s answered '%.80s'; not counted", id.c_str(), line.c_str());
       return answered(phase, id, std::nullopt);
     }
     answered(phase, id, parsed.message);
@@ -283,7 +284,7 @@ void RegistryClient::settle(const std::shared_ptr<Phase>& phase) {
 
 void RegistryClient::retry_or_give_up(const std::shared_ptr<Round>& round) {
   if (round->attempt >= kAttempts) {
-    std::fprintf(stderr, "[registry] uid %s: no home %s after %d ballots; the participant retries\n",
+    rfbsim::log::warn("registry", "uid %s: no home %s after %d ballots; the participant retries",
                  round->uid.c_str(), round->learn_only ? "learned" : "decided", round->attempt);
     round->done(LearnResult{});
     return;

@@ -17,6 +17,7 @@
 #include "http/accept_pause.hpp"
 #include "cluster/uid_registry.hpp"
 #include "admission/unix_time.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -95,7 +96,7 @@ void RegistryServer::handle(const RegistryMessage& request, Answered done) {
       if (state != before) store_.set_uid_acceptor(request.uid, state, std::chrono::system_clock::now());
       answer = std::move(reply);
     } catch (const std::exception& error) {
-      std::fprintf(stderr, "[registry] cannot keep the acceptor state of uid %s: %s\n", request.uid.c_str(),
+      rfbsim::log::warn("registry", "cannot keep the acceptor state of uid %s: %s", request.uid.c_str(),
                    error.what());
     }
     asio::post(io_, [done = std::move(done), answer = std::move(answer)] { done(answer); });
@@ -146,7 +147,7 @@ void RegistryServer::serve(tcp::socket socket) {
             parsed.message ? request_problem(*parsed.message, self_, peers_, unix_seconds_now()) : parsed.error;
         if (!problem.empty()) {
           // A bad hmac from a real peer means another secret or another cluster_peers list on that host.
-          std::fprintf(stderr, "[registry] refused a request: %s%s\n", problem.c_str(),
+          rfbsim::log::limited(rfbsim::log::Level::kWarn, "registry-refused", "registry", "refused a request: %s%s", problem.c_str(),
                        problem == "bad hmac" ? " (another cluster_secret_file or cluster_peers list?)" : "");
           answer(connection, error_line(problem));
           return;
@@ -184,7 +185,7 @@ std::string read_cluster_secret(const std::string& path) {
   }
   struct stat status{};
   if (::stat(path.c_str(), &status) == 0 && (status.st_mode & 077) != 0) {
-    std::fprintf(stderr, "[registry] warning: %s may be read by other users; chmod 600 it (docs/security.md)\n",
+    rfbsim::log::warn("registry", "warning: %s may be read by other users; chmod 600 it (docs/security.md)",
                  path.c_str());
   }
   return secret;

@@ -105,6 +105,8 @@ struct ManagerConfig {
   /// manager's user can connect) or "tcp" (a loopback port, which any local user could open; for tools that
   /// connect to sessions directly, such as bench_manager's direct path).
   std::string session_socket = "unix";
+  /// The manager's log: error, warn, info (the default) or debug (rfbsim/log.hpp).
+  std::string log_level = "info";
   int max_sessions = 4;                      ///< live sessions at once; the next participant is told to wait
   /// A session is ended this long after /start (SEAN-EP: 5 min). Unless set, fit_max_duration raises it to
   /// what the offered scenarios' tasks need.

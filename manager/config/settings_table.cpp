@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "config/settings_table.hpp"
 
+#include "rfbsim/log.hpp"
+
 #include <arpa/inet.h>
 #include <yaml-cpp/yaml.h>
 
@@ -176,6 +178,12 @@ const std::map<std::string, Setting>& settings() {
       {"codec", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          if (v.front() != "auto" && v.front() != "jpeg" && v.front() != "h264") return "expected auto, jpeg or h264";
          c.codec = v.front();
+         return "";
+       }}},
+      {"log_level", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
+         rfbsim::log::Level level{};
+         if (!rfbsim::log::parse_level(v.front(), level)) return "expected error, warn, info or debug";
+         c.log_level = v.front();
          return "";
        }}},
       {"session_socket", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {

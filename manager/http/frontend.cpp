@@ -25,6 +25,7 @@
 #include "http/websocket_gate.hpp"
 #include "sessions/session_views.hpp"
 #include "static_files.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -112,7 +113,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
     try {
       work();
     } catch (const std::exception& error) {
-      std::fprintf(stderr, "[manager] %s failed: %s; its connection is closed\n", what, error.what());
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "handler-exception", "manager", "%s failed: %s; its connection is closed", what, error.what());
       websocketpp::lib::error_code ec;
       auto con = server_.get_con_from_hdl(hdl, ec);
       if (!ec) con->terminate(ec);
@@ -295,7 +296,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
     try {
       in.has_session = supervisor_.has_session_for_uid(uid);
     } catch (const std::exception& error) {
-      std::fprintf(stderr, "[manager] /start of uid %s: cannot read the index (%s); asked to retry\n", uid.c_str(),
+      rfbsim::log::warn("manager", "/start of uid %s: cannot read the index (%s); asked to retry\n", uid.c_str(),
                    error.what());
     }
     in.shutting_down = supervisor_.shutting_down();
@@ -425,7 +426,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
   void handle_api_drain(const ConnectionPtr& con, bool drain) {
     if (!admin_post_allowed(con)) return;
     if (supervisor_.draining() != drain) {
-      std::fprintf(stderr, "[manager] %s by the administrator (%zu live session(s))\n",
+      rfbsim::log::info("manager", "%s by the administrator (%zu live session(s))",
                    drain ? "draining: no new participants" : "taking new participants again",
                    supervisor_.table().size());
     }

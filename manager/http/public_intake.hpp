@@ -21,6 +21,7 @@
 #include "config/config.hpp"
 #include "http/connection_limits.hpp"
 #include "admin/metrics.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -133,7 +134,7 @@ class PublicIntake {
   void pause(const std::string& why) {
     metrics_.count_accept_error();
     if (!paused_) {
-      std::fprintf(stderr, "[manager] accepting connections failed (%s); pausing %lld ms between tries\n", why.c_str(),
+      rfbsim::log::warn("manager", "accepting connections failed (%s); pausing %lld ms between tries\n", why.c_str(),
                    static_cast<long long>(kAcceptPause.count()));
     }
     paused_ = true;
@@ -152,7 +153,7 @@ class PublicIntake {
       return;
     }
     if (paused_) {
-      std::fprintf(stderr, "[manager] accepting connections again\n");
+      rfbsim::log::info("manager", "accepting connections again");
       paused_ = false;
     }
     admit(con);
@@ -180,7 +181,7 @@ class PublicIntake {
       const auto now = std::chrono::steady_clock::now();
       if (now - last_refusal_log_ >= intake_detail::kRefusalLogInterval) {
         last_refusal_log_ = now;
-        std::fprintf(stderr, "[manager] refused connections over the cap (%zu open, %zu from %s)\n",
+        rfbsim::log::limited(rfbsim::log::Level::kWarn, "connection-cap", "manager", "refused connections over the cap (%zu open, %zu from %s)",
                      limits_.open_total(), limits_.open(key), key.c_str());
       }
       socket.close(ec);

@@ -24,6 +24,7 @@
 #include "http/web_policy.hpp"
 #include "sessions/session_views.hpp"
 #include "sessions/supervisor.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -278,7 +279,7 @@ class WebSocketGate {
     for (auto& [hdl, relay] : relays) {
       if (relay->session_id() != session.id || relay->kind() != RelayKind::kParticipant) continue;
       metrics_.count_takeover();
-      std::fprintf(stderr, "[manager] session %lld (uid %s): a newer browser took over; the earlier one is told\n",
+      rfbsim::log::limited(rfbsim::log::Level::kInfo, "takeover", "manager", "session %lld (uid %s): a newer browser took over; the earlier one is told",
                    static_cast<long long>(session.id), session.uid.c_str());
       relay->close(static_cast<websocketpp::close::status::value>(websocket_gate_detail::kTakenOverCode), websocket_gate_detail::kTakenOverReason);
     }

@@ -19,6 +19,7 @@
 
 #include "sessions/session.hpp"
 #include "sessions/session_process.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -40,7 +41,7 @@ const std::vector<std::string> kCopyVariables = {"USER", "LOGNAME", "SSH_AUTH_SO
                                                  "XDG_CONFIG_HOME"};
 
 void log_copy(const CopyJob& job, const std::string& text) {
-  std::fprintf(stderr, "[manager] session %lld (uid %s): %s\n", static_cast<long long>(job.session_id),
+  rfbsim::log::info("manager", "session %lld (uid %s): %s", static_cast<long long>(job.session_id),
                job.uid.c_str(), text.c_str());
 }
 

@@ -31,6 +31,7 @@
 #include "admission/tokens.hpp"
 #include "x11_display.hpp"
 #include "sessions/supervisor_runtime.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -164,7 +165,7 @@ void Supervisor::clean_x11_display(int display, int attempt) {
   if (display < 0 || x11::remove_stale_display(display)) return;
   // Its Xvnc was killed with the group a moment ago and may not be gone yet: look again, for a few seconds.
   if (attempt >= 20) {
-    std::fprintf(stderr, "[manager] display :%d: its X server is still running; its lock file is left\n", display);
+    rfbsim::log::info("manager", "display :%d: its X server is still running; its lock file is left", display);
     return;
   }
   auto timer = std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(250));

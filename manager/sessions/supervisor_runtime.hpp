@@ -16,6 +16,7 @@
 #include <string>
 
 #include "sessions/supervisor.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -42,7 +43,7 @@ struct Supervisor::ChildWatch {
 
 /// One line of the manager's log about `session`.
 inline void log_session(const Session& session, const std::string& text) {
-  std::fprintf(stderr, "[manager] session %lld (uid %s): %s\n", static_cast<long long>(session.id),
+  rfbsim::log::info("manager", "session %lld (uid %s): %s", static_cast<long long>(session.id),
                session.uid.c_str(), text.c_str());
 }
 
