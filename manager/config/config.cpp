@@ -17,6 +17,8 @@
 #include "sessions/copy_command.hpp"
 #include "sessions/launch_plan.hpp"
 #include "config/ros_settings.hpp"
+#include "contract/task_bounds.hpp"
+#include "contract/validators.hpp"
 #include "http/routes.hpp"
 #include "admission/start_request.hpp"
 #include "cluster/uid_registry.hpp"
@@ -24,6 +26,9 @@
 namespace rfbsim::manager {
 
 namespace {
+
+// limits.cpu_slack_s's bound: a day of CPU beyond the session's share (a guard against typos, not a task bound).
+constexpr long long kMaxCpuSlackS = 24LL * 3600;
 
 // Applies a setting's values (one for a scalar, any number for a list); returns "" or what is wrong.
 using Apply = std::function<std::string(ManagerConfig&, const std::vector<std::string>&)>;
@@ -116,24 +121,9 @@ Apply boolean(bool ManagerConfig::*field) {
   };
 }
 
-// An origin as browsers send it: scheme://host[:port], nothing after.
-bool is_origin(const std::string& origin) {
-  std::string_view rest(origin);
-  if (rest.rfind("https://", 0) == 0) {
-    rest.remove_prefix(8);
-  } else if (rest.rfind("http://", 0) == 0) {
-    rest.remove_prefix(7);
-  } else {
-    return false;
-  }
-  if (rest.empty()) return false;
-  for (const char ch : rest) {
-    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '.' || ch == '-' || ch == ':' ||
-                    ch == '[' || ch == ']';
-    if (!ok) return false;  // upper case, paths, queries, user info: not an origin as browsers send it
-  }
-  return true;
-}
+// An origin as browsers send it, scheme://host[:port] and nothing after: frame origins are compared with the
+// Origin header byte for byte (the contract's rule, of the same shape as sim_rfb's --allow-origin).
+bool is_origin(const std::string& origin) { return contract::is_browser_origin(origin); }
 
 // A host name as DNS compares it: ASCII letters without case.
 std::string lower_case(std::string text) {
@@ -370,7 +360,9 @@ const std::map<std::string, Setting>& settings() {
        }}},
       {"limit_cpu_slack_s", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          long long value = 0;
-         if (!parse_integer(v.front(), 0LL, 86400LL, value)) return "expected whole seconds 0..86400";
+         if (!parse_integer(v.front(), 0LL, kMaxCpuSlackS, value)) {
+           return "expected whole seconds 0.." + std::to_string(kMaxCpuSlackS);
+         }
          c.limits.cpu_slack = std::chrono::seconds(value);
          return "";
        }}},
@@ -813,9 +805,11 @@ namespace {
 // arguments over the scenario's.
 double task_time_limit(const ManagerConfig& config, const ScenarioFacts& facts) {
   double limit = facts.time_limit_s;
+  constexpr long long kLow = contract::kMinTimeLimitS;  // sim_rfb's bounds for the flag and the scenario's key
+  constexpr long long kHigh = contract::kMaxTimeLimitS;
   for (std::size_t i = 0; config.session_kind == SessionKind::kSimRfb && i + 1 < config.session_args.size(); ++i) {
     long long value = 0;
-    if (config.session_args[i] == "--time-limit" && parse_integer(config.session_args[i + 1], 1LL, 86400LL, value)) {
+    if (config.session_args[i] == "--time-limit" && parse_integer(config.session_args[i + 1], kLow, kHigh, value)) {
       limit = static_cast<double>(value);
     }
   }

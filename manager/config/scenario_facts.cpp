@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "admission/start_request.hpp"
+#include "contract/task_bounds.hpp"
 
 namespace rfbsim::manager {
 
@@ -91,8 +92,10 @@ std::optional<ScenarioFacts> parse_scenario_facts(const std::string& text, const
       return std::nullopt;
     }
     facts.has_task = true;
-    if (!read_seconds(task, "time_limit", 1.0, 86400.0, file, facts.time_limit_s, error) ||
-        !read_seconds(task, "end_grace", 0.0, 3600.0, file, facts.end_grace_s, error)) {
+    if (!read_seconds(task, "time_limit", contract::kMinTimeLimitS, contract::kMaxTimeLimitS, file, facts.time_limit_s,
+                      error) ||
+        !read_seconds(task, "end_grace", contract::kMinEndGraceS, contract::kMaxEndGraceS, file, facts.end_grace_s,
+                      error)) {
       return std::nullopt;
     }
   }

@@ -28,7 +28,7 @@ struct ScenarioFacts {
 };
 
 /// Reads ScenarioFacts from a scenario file's text (`file` names it in errors). nullopt and `error` ("<file>:<line>:
-/// task.time_limit: expected seconds 1..86400") when the text is not YAML or a key it reads is malformed.
+/// task.time_limit: expected seconds 1..<contract::kMaxTimeLimitS>") when the text is not YAML or a key it reads is malformed.
 std::optional<ScenarioFacts> parse_scenario_facts(const std::string& text, const std::string& name,
                                                   const std::string& file, std::string& error);
 
