@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "contract/stream_line.hpp"
 #include "sessions/session.hpp"
-#include "sessions/stream_report.hpp"
 
 namespace rfbsim::manager {
 

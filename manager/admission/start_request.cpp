@@ -15,7 +15,6 @@ const std::vector<OverrideParam> kOverrideParams = {
 
 namespace {
 
-constexpr std::size_t kMaxIdentifier = 64;
 // Maps are tens of metres; anything beyond this is a typo or an attack, not a pose.
 constexpr double kMaxCoordinate = 10000.0;
 constexpr double kMaxYaw = 7.0;  // a little over 2 pi
@@ -70,13 +69,6 @@ bool names_spawn(const std::string& value) { return is_identifier(value); }
 
 }  // namespace
 
-bool is_identifier(std::string_view text) {
-  if (text.empty() || text.size() > kMaxIdentifier) return false;
-  return std::all_of(text.begin(), text.end(), [](char ch) {
-    return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '-' ||
-           ch == '_';
-  });
-}
 
 bool is_pose(std::string_view text) {
   if (is_identifier(text)) return true;

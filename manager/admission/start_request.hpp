@@ -12,8 +12,9 @@
 #include <utility>
 #include <vector>
 
-#include "http/query.hpp"
 #include "config/scenario_facts.hpp"
+#include "contract/validators.hpp"
+#include "http/query.hpp"
 
 namespace rfbsim::manager {
 
@@ -48,8 +49,9 @@ struct StartParse {
   std::string error;
 };
 
-/// True for 1..64 letters, digits, '-' and '_': safe in paths, logs and command lines.
-bool is_identifier(std::string_view text);
+/// True for 1..64 letters, digits, '-' and '_': safe in paths, logs and command lines. The contract's, which
+/// sim_rfb applies to the same uid and codes.
+using contract::is_identifier;
 
 /// A pose: a spawn point's name (an identifier) or "x,y,yaw" in metres and radians, strictly decimal.
 bool is_pose(std::string_view text);

@@ -18,6 +18,8 @@
 #include "sessions/copy_command.hpp"
 #include "sessions/launch_plan.hpp"
 #include "config/ros_settings.hpp"
+#include "contract/task_bounds.hpp"
+#include "contract/validators.hpp"
 #include "http/routes.hpp"
 #include "admission/start_request.hpp"
 #include "cluster/uid_registry.hpp"
@@ -338,9 +340,11 @@ namespace {
 // arguments over the scenario's.
 double task_time_limit(const ManagerConfig& config, const ScenarioFacts& facts) {
   double limit = facts.time_limit_s;
+  constexpr long long kLow = contract::kMinTimeLimitS;  // sim_rfb's bounds for the flag and the scenario's key
+  constexpr long long kHigh = contract::kMaxTimeLimitS;
   for (std::size_t i = 0; config.session_kind == SessionKind::kSimRfb && i + 1 < config.session_args.size(); ++i) {
     long long value = 0;
-    if (config.session_args[i] == "--time-limit" && parse_integer(config.session_args[i + 1], 1LL, 86400LL, value)) {
+    if (config.session_args[i] == "--time-limit" && parse_integer(config.session_args[i + 1], kLow, kHigh, value)) {
       limit = static_cast<double>(value);
     }
   }

@@ -5,17 +5,16 @@
 #include <filesystem>
 #include <fstream>
 
+#include "contract/validators.hpp"
+
 namespace rfbsim::manager {
 
 namespace {
 
-constexpr std::size_t kMaxRosName = 200;
-constexpr std::size_t kMaxUrl = 2048;
 constexpr std::size_t kMaxToken = 4096;
 // A CA bundle is kilobytes; anything far larger is the wrong file.
 constexpr std::size_t kMaxCaFile = 4 * 1024 * 1024;
 
-bool is_letter(char ch) { return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z'); }
 bool is_visible(char ch) { return ch > ' ' && ch < 0x7f; }
 
 // The file's first `limit` + 1 bytes, so that an oversized file is seen as one; `ok` is false when it is not a
@@ -34,44 +33,11 @@ std::string read_head(const std::string& path, std::size_t limit, bool& ok) {
 
 }  // namespace
 
-bool is_ros_name(std::string_view name) {
-  if (name.size() < 2 || name.size() > kMaxRosName || name.front() != '/' || name.back() == '/') return false;
-  bool segment_start = true;
-  for (std::size_t i = 1; i < name.size(); ++i) {
-    const char ch = name[i];
-    if (ch == '/') {
-      if (segment_start) return false;  // "//": an empty segment
-      segment_start = true;
-      continue;
-    }
-    if (segment_start ? !is_letter(ch) : !(is_letter(ch) || (ch >= '0' && ch <= '9') || ch == '_')) return false;
-    segment_start = false;
-  }
-  return true;
-}
+// The contract's rules (sim_rfb checks the same), with the root's own limit: room for each session's
+// "/s_<id>_<host>" under sim_rfb's.
+bool is_ros_name(std::string_view name) { return contract::is_ros_name(name, contract::kMaxRosRootName); }
 
-std::string rosbridge_url_problem(std::string_view url) {
-  if (url.size() > kMaxUrl) return "is longer than " + std::to_string(kMaxUrl) + " characters";
-  std::string_view rest = url;
-  if (rest.rfind("wss://", 0) == 0) {
-    rest.remove_prefix(6);
-  } else if (rest.rfind("ws://", 0) == 0) {
-    rest.remove_prefix(5);
-  } else {
-    return "expected a ws:// or wss:// URL such as wss://ros.lab.example.org:9090/";
-  }
-  for (const char ch : url) {
-    if (!is_visible(ch)) return "must not hold spaces or control characters";
-  }
-  const std::string_view authority = rest.substr(0, rest.find_first_of("/?#"));
-  if (authority.empty() || authority.front() == ':') return "has no host";
-  if (authority.find('@') != std::string_view::npos) {
-    return "must not hold user info (user@host): put the credential in token_file";
-  }
-  // Sessions log the URL and record it in session.json: a query or fragment could carry a credential.
-  if (url.find_first_of("?#") != std::string_view::npos) return "must not hold a query or fragment: put a credential in token_file";
-  return "";
-}
+std::string rosbridge_url_problem(std::string_view url) { return contract::websocket_url_problem(url); }
 
 std::string token_file_problem(const std::string& path) {
   bool ok = false;

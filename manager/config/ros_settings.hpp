@@ -30,7 +30,8 @@ struct RosSettings {
 };
 
 /// A ROS graph name as sim_rfb's --ros-namespace takes it: '/', then one or more segments of [A-Za-z0-9_] that
-/// start with a letter, joined by single '/', with no trailing '/'; at most 200 characters. E.g. "/rfbsim/s_12".
+/// start with a letter, joined by single '/', with no trailing '/'; at most contract::kMaxRosRootName (200)
+/// characters, so that each session's name under it fits sim_rfb's limit. E.g. "/rfbsim/s_12".
 bool is_ros_name(std::string_view name);
 
 /// Why `url` cannot be the lab's rosbridge_server ("" when it can): ws:// or wss://, then a host (and optional

@@ -18,6 +18,8 @@
 #include "sessions/copy_command.hpp"
 #include "sessions/launch_plan.hpp"
 #include "config/ros_settings.hpp"
+#include "contract/task_bounds.hpp"
+#include "contract/validators.hpp"
 #include "http/routes.hpp"
 #include "admission/start_request.hpp"
 #include "cluster/uid_registry.hpp"
@@ -25,6 +27,9 @@
 namespace rfbsim::manager::config_table {
 
 namespace {
+
+// limits.cpu_slack_s's bound: a day of CPU beyond the session's share (a guard against typos, not a task bound).
+constexpr long long kMaxCpuSlackS = 24LL * 3600;
 
 Apply integer(int ManagerConfig::*field, int low, int high) {
   return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
@@ -99,24 +104,9 @@ Apply boolean(bool ManagerConfig::*field) {
   };
 }
 
-// An origin as browsers send it: scheme://host[:port], nothing after.
-bool is_origin(const std::string& origin) {
-  std::string_view rest(origin);
-  if (rest.rfind("https://", 0) == 0) {
-    rest.remove_prefix(8);
-  } else if (rest.rfind("http://", 0) == 0) {
-    rest.remove_prefix(7);
-  } else {
-    return false;
-  }
-  if (rest.empty()) return false;
-  for (const char ch : rest) {
-    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '.' || ch == '-' || ch == ':' ||
-                    ch == '[' || ch == ']';
-    if (!ok) return false;  // upper case, paths, queries, user info: not an origin as browsers send it
-  }
-  return true;
-}
+// An origin as browsers send it, scheme://host[:port] and nothing after: frame origins are compared with the
+// Origin header byte for byte (the contract's rule, of the same shape as sim_rfb's --allow-origin).
+bool is_origin(const std::string& origin) { return contract::is_browser_origin(origin); }
 
 // A host name as DNS compares it: ASCII letters without case.
 std::string lower_case(std::string text) {
@@ -361,7 +351,9 @@ const std::map<std::string, Setting>& settings() {
        }}},
       {"limit_cpu_slack_s", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
          long long value = 0;
-         if (!parse_integer(v.front(), 0LL, 86400LL, value)) return "expected whole seconds 0..86400";
+         if (!parse_integer(v.front(), 0LL, kMaxCpuSlackS, value)) {
+           return "expected whole seconds 0.." + std::to_string(kMaxCpuSlackS);
+         }
          c.limits.cpu_slack = std::chrono::seconds(value);
          return "";
        }}},

@@ -19,9 +19,12 @@
 #include <string>
 #include <string_view>
 
-#include "sessions/stream_report.hpp"
+#include "contract/stream_line.hpp"
 
 namespace rfbsim::manager {
+
+/// sim_rfb's latest stream line, as the contract parses it (contract/stream_line.hpp).
+using contract::StreamReport;
 
 enum class SessionState {
   kStarting,     ///< process started, not yet ready

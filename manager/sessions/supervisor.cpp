@@ -23,7 +23,9 @@
 #include <fstream>
 #include <stdexcept>
 #include <thread>
+#include <variant>
 
+#include "contract/ready_line.hpp"
 #include "sessions/launch_plan.hpp"
 #include "sessions/process_launcher.hpp"
 #include "record/digest.hpp"
@@ -224,31 +226,33 @@ void Supervisor::watch_ready_pipe(Session& session) {
 }
 
 bool Supervisor::take_pipe_line(Session& session, const std::string& line) {
+  // The contract's parser (contract/ready_line.hpp): the same grammar sim_rfb and rfbsim_x11_session write with.
+  const contract::ReadyLineParse parsed = contract::parse_ready_line(line);
+  const contract::ReadyLine* value = parsed.line ? &*parsed.line : nullptr;
   if (session.state == SessionState::kStarting) {
     // On a unix socket: "ready unix PATH", and only the path it was given.
     if (!session.unix_socket.empty()) {
-      if (line != "ready unix " + session.unix_socket) {
+      const auto* ready = value != nullptr ? std::get_if<contract::ReadyUnix>(value) : nullptr;
+      if (ready == nullptr || ready->path != session.unix_socket) {
         begin_end(session, SessionState::kFailed, "the program's ready line is not 'ready unix " + session.unix_socket + "'");
         return false;
       }
       mark_ready(session, 0);
       return true;
     }
-    int port = 0;
-    char rest = 0;
-    if (std::sscanf(line.c_str(), "ready %d%c", &port, &rest) != 1 || port < 1 || port > 65535) {
+    const auto* ready = value != nullptr ? std::get_if<contract::ReadyPort>(value) : nullptr;
+    if (ready == nullptr) {
       begin_end(session, SessionState::kFailed, "the program's ready line is not 'ready PORT'");
       return false;
     }
-    mark_ready(session, port);
+    mark_ready(session, ready->port);
     return true;
   }
   // The participant's stream, about once a second while someone watches: the latest is kept for the admin page,
   // the API and the metrics (not the index: it is a reading, not the session's record).
-  if (is_stream_line(line)) {
-    StreamParse parsed = parse_stream_line(line);
-    if (parsed.report) {
-      session.stream = parsed.report->clients > 0 ? parsed.report : std::nullopt;
+  if (contract::is_stream_line(line)) {
+    if (const auto* stream = value != nullptr ? std::get_if<StreamReport>(value) : nullptr) {
+      session.stream = stream->clients > 0 ? std::optional<StreamReport>(*stream) : std::nullopt;
     } else if (!runtime(session.id).bad_stream_logged) {
       runtime(session.id).bad_stream_logged = true;
       log_session(session, "ignored a stream line (" + parsed.error + "), and will not log another: '" +
@@ -257,28 +261,24 @@ bool Supervisor::take_pipe_line(Session& session, const std::string& line) {
     return true;
   }
   // rfbsim_x11_session names the display it got, so that one whose X server was SIGKILLed is cleaned after it.
-  if (config_.session_kind == SessionKind::kX11 && line.rfind("x11 display ", 0) == 0 &&
-      runtime(session.id).x11_display < 0) {
-    int display = -1;
-    char rest = 0;
-    if (std::sscanf(line.c_str() + 12, "%d%c", &display, &rest) == 1 && display >= 0 && display < 65536) {
-      runtime(session.id).x11_display = display;
-      log_session(session, "its program runs on display :" + std::to_string(display));
-      return true;
-    }
+  const auto* display = value != nullptr ? std::get_if<contract::X11Display>(value) : nullptr;
+  if (display != nullptr && config_.session_kind == SessionKind::kX11 && runtime(session.id).x11_display < 0) {
+    runtime(session.id).x11_display = display->display;
+    log_session(session, "its program runs on display :" + std::to_string(display->display));
+    return true;
   }
-  if ((line == "outcome completed" || line == "outcome timeout") && session.outcome.empty()) {
-    session.outcome = line.substr(8);
+  const auto* outcome = value != nullptr ? std::get_if<contract::TaskOutcomeLine>(value) : nullptr;
+  if (outcome != nullptr && session.outcome.empty()) {
+    session.outcome = contract::task_end_name(outcome->end);
     save(session);
     log_session(session, "task outcome: " + session.outcome);
     return true;
   }
   // The program can no longer write the session's data (a full disk): recorded, and by the config's policy
   // the participant carries on or the session ends.
-  if (line.rfind("data incomplete", 0) == 0 && session.data_incomplete.empty()) {
-    const std::size_t reason_at = line.find("reason=");
-    session.data_incomplete = reason_at == std::string::npos ? "unknown" : line.substr(reason_at + 7, 160);
-    if (session.data_incomplete.empty()) session.data_incomplete = "unknown";
+  const auto* incomplete = value != nullptr ? std::get_if<contract::DataIncomplete>(value) : nullptr;
+  if (incomplete != nullptr && session.data_incomplete.empty()) {
+    session.data_incomplete = incomplete->reason;
     save(session);
     log_session(session, "its data is incomplete: " + session.data_incomplete);
     if (config_.on_data_incomplete == DataFailurePolicy::kEnd) {

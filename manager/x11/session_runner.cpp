@@ -21,6 +21,7 @@
 #include <string>
 #include <utility>
 
+#include "contract/ready_line.hpp"
 #include "child_process.hpp"
 #include "x11_display.hpp"
 #include "xauthority.hpp"
@@ -266,7 +267,7 @@ int run_session(const SessionOptions& options) {
   std::printf("display :%d\n", display);
   std::fflush(stdout);
   if (ready.fd >= 0) {
-    const std::string lines = "ready unix " + options.rfb_socket + "\nx11 display " + std::to_string(display) + "\n";
+    const std::string lines = contract::ready_unix_line(options.rfb_socket) + contract::x11_display_line(display);
     if (!write_all(ready.fd, lines)) say(std::string("cannot write the ready lines: ") + std::strerror(errno));
     ready.reset();
   }

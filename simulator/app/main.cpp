@@ -32,6 +32,7 @@
 #include "app/simulation.hpp"
 #include "app/stream_status.hpp"
 #include "app/study_session.hpp"
+#include "contract/ready_line.hpp"
 #include "record/digest.hpp"
 #include "record/session_writer.hpp"
 #include "rfbsim/offscreen_gl.hpp"
@@ -89,8 +90,9 @@ std::string write_line(int fd, const std::string& line) {
 // listening on a unix socket). The pipe stays open for the outcome line. Throws std::runtime_error when the write fails (EPIPE: the parent left).
 void report_ready(int fd, const rfbsim::Server& server) {
   const std::string& unix_socket = server.options().unix_socket_path;
-  const std::string line = unix_socket.empty() ? "ready " + std::to_string(server.port()) + "\n"
-                                               : "ready unix " + unix_socket + "\n";
+  namespace contract = rfbsim::contract;
+  const std::string line =
+      unix_socket.empty() ? contract::ready_port_line(server.port()) : contract::ready_unix_line(unix_socket);
   const std::string error = write_line(fd, line);
   if (!error.empty()) {
     ::close(fd);
@@ -430,7 +432,9 @@ int run(const rfbsim::sim::SimOptions& options) {
       const char* outcome = sim::task_outcome_name(study.outcome());
       std::fprintf(stderr, "[task] %.2f s outcome %s\n", simulation.world().time, outcome);
       if (options.ready_fd) {
-        const std::string error = write_line(*options.ready_fd, std::string("outcome ") + outcome + "\n");
+        const auto end = study.outcome() == sim::TaskOutcome::Completed ? rfbsim::contract::TaskEnd::kCompleted
+                                                                        : rfbsim::contract::TaskEnd::kTimeout;
+        const std::string error = write_line(*options.ready_fd, rfbsim::contract::outcome_line(end));
         if (!error.empty()) std::fprintf(stderr, "[sim_rfb] cannot report the outcome to the parent: %s\n", error.c_str());
       }
     }

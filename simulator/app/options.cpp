@@ -8,6 +8,8 @@
 #include <functional>
 #include <map>
 
+#include "contract/validators.hpp"
+
 namespace rfbsim::sim {
 
 namespace {
@@ -22,61 +24,18 @@ bool parse_number(const std::string& text, T low, T high, T& out) {
   return true;
 }
 
-// Participant ids and completion codes: safe in file names, logs and the HUD.
-bool is_identifier(const std::string& text) {
-  if (text.empty() || text.size() > 64) return false;
-  for (const char c : text) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
-    if (!ok) return false;
-  }
-  return true;
-}
+// The values sim_manager also checks before it passes them here: one rule each, in the contract
+// (contract/validators.hpp), so that the two programs cannot disagree.
+using contract::is_identifier;      // participant ids and completion codes
+using contract::looks_like_origin;  // --allow-origin's shape; librfbsim checks the host and port when it starts
 
-// The shape of an --allow-origin value; librfbsim checks the host and port when the server starts.
-bool looks_like_origin(const std::string& text) {
-  if (text == "*") return true;
-  for (const std::string scheme : {"http://", "https://"}) {
-    if (text.rfind(scheme, 0) == 0) {
-      return text.size() > scheme.size() && text.find_first_of("/?#@ ", scheme.size()) == std::string::npos;
-    }
-  }
-  return false;
-}
-
-// A ROS graph name used as a topic prefix: "/" then segments of letters, digits and _ (each starting with a
-// letter), joined by "/", no trailing "/".
-bool is_ros_namespace(const std::string& text) {
-  // sim_manager accepts a 200-character root and appends "/s_<id>_<host>": 512 leaves room for both.
-  if (text.size() < 2 || text.size() > 512 || text[0] != '/') return false;
-  bool segment_start = true;
-  for (std::size_t i = 1; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c == '/') {
-      if (segment_start) return false;
-      segment_start = true;
-      continue;
-    }
-    const bool letter = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
-    const bool ok = letter || (!segment_start && ((c >= '0' && c <= '9') || c == '_'));
-    if (!ok) return false;
-    segment_start = false;
-  }
-  return !segment_start;
-}
+// A ROS graph name used as a topic prefix, up to the contract's kMaxRosName (room for sim_manager's root and
+// its "/s_<id>_<host>").
+bool is_ros_namespace(const std::string& text) { return contract::is_ros_name(text); }
 
 // ws://host[:port][/path] or wss://...: the shape only (the client parses it fully when it starts). No user info
 // and no query: credentials go in --rosbridge-token-file, never in a URL that logs, session.json and ps show.
-bool looks_like_websocket_url(const std::string& text) {
-  for (const std::string scheme : {"ws://", "wss://"}) {
-    if (text.rfind(scheme, 0) == 0) {
-      const std::string authority = text.substr(scheme.size(), text.find('/', scheme.size()) - scheme.size());
-      return text.size() > scheme.size() && text.size() <= 2048 && !authority.empty() &&
-             authority.find('@') == std::string::npos && text.find_first_of("?#") == std::string::npos &&
-             std::none_of(text.begin(), text.end(), [](unsigned char c) { return c <= 0x20 || c == 0x7f; });
-    }
-  }
-  return false;
-}
+bool looks_like_websocket_url(const std::string& text) { return contract::websocket_url_problem(text).empty(); }
 
 }  // namespace
 

@@ -6,19 +6,15 @@
 #include <cmath>
 #include <cstdio>
 
+#include "contract/stream_line.hpp"
+
 namespace rfbsim::sim {
 
 namespace {
 
-// A codec's name as the line and the JSON carry it: 1 to 16 lower-case letters and digits; "" for anything
-// else, which is then left out rather than passed on to sim_manager's labels and pages.
-std::string clean_name(const std::string& name) {
-  if (name.empty() || name.size() > 16) return "";
-  for (const char c : name) {
-    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'))) return "";
-  }
-  return name;
-}
+// A codec's name as the JSON carries it (the stream line's rule); "" for anything else, which is then left out
+// rather than passed on to sim_manager's labels and pages.
+std::string clean_name(const std::string& name) { return contract::is_codec_name(name) ? name : ""; }
 
 // A number for JSON with `decimals` decimals; null when it is not finite (never expected, never invalid JSON).
 std::string json_number(double value, int decimals) {
@@ -30,11 +26,6 @@ std::string json_number(double value, int decimals) {
 
 // A round trip for JSON: null while not measured (the library says -1).
 std::string json_rtt(double ms) { return ms < 0 ? "null" : json_number(ms, 1); }
-
-// `value` limited to low..high; low when it is not finite.
-double clamped(double value, double low, double high) {
-  return std::isfinite(value) ? std::clamp(value, low, high) : low;
-}
 
 }  // namespace
 
@@ -70,21 +61,16 @@ std::string streams_json(const std::vector<rfbsim::ClientStreamStatus>& streams)
 }
 
 std::string stream_line(const std::vector<rfbsim::ClientStreamStatus>& streams) {
+  contract::StreamReport report;
   const rfbsim::ClientStreamStatus* participant = main_stream(streams);
-  const int clients = static_cast<int>(std::min<std::size_t>(streams.size(), 9999));
-  if (participant == nullptr) return "stream clients=0\n";
-  // Every value bounded, so that the line stays short: 600000 ms is ten minutes, 1000 fps beyond any display.
-  std::string line = "stream";
-  const std::string codec = clean_name(participant->encoding);
-  if (!codec.empty()) line += " codec=" + codec;
-  char rtt[32] = " rtt_ms=-1";
-  if (participant->last_rtt_ms >= 0) {
-    std::snprintf(rtt, sizeof rtt, " rtt_ms=%.1f", clamped(participant->last_rtt_ms, 0, 600000));
-  }
-  char rest[64];
-  std::snprintf(rest, sizeof rest, " fps=%.1f quality=%d clients=%d\n", clamped(participant->fps, 0, 1000),
-                std::clamp(participant->quality, 0, 100), clients);
-  return line + rtt + rest;
+  if (participant == nullptr) return contract::stream_line(report);  // nobody watches: "stream clients=0"
+  // The writer bounds every value and drops a codec name that is not one.
+  report.clients = static_cast<int>(std::min<std::size_t>(streams.size(), contract::kMaxStreamClients));
+  report.codec = participant->encoding;
+  if (participant->last_rtt_ms >= 0) report.rtt_ms = participant->last_rtt_ms;  // the library says -1 until measured
+  report.fps = participant->fps;
+  report.quality = participant->quality;
+  return contract::stream_line(report);
 }
 
 }  // namespace rfbsim::sim

@@ -3,20 +3,9 @@
 // /status.json, and as the "stream" line on the ready pipe that sim_manager reads. Pure text: the caller asks
 // the server for rfbsim::Server::client_streams() and writes the result where it belongs.
 //
-// The ready pipe's line, one about every second while someone watches and one when the last viewer leaves:
-//
-//   stream codec=tight rtt_ms=12.5 fps=29.8 quality=80 clients=1
-//   stream clients=0
-//
-// Space-separated key=value pairs after the word "stream", in this order, describing the participant's stream
-// (the client that has had the most updates; see main_stream()):
-//   codec    "tight" or "h264" (the stream's encoding; left out when the server names none)
-//   rtt_ms   the latest round trip measured with fences, ms, one decimal; -1 while none was measured (a client
-//            without Fence support, or before its first answer)
-//   fps      updates per second over about the last second, one decimal
-//   quality  the JPEG quality in use 1..100 (Tight), or the configured one (H.264)
-//   clients  how many viewers are connected; with 0 no other key follows
-// Readers must ignore keys they do not know: later versions may add some. docs/deployment.md describes it too.
+// The ready pipe's line ("stream codec=tight rtt_ms=12.5 fps=29.8 quality=80 clients=1", or "stream clients=0"
+// when the last viewer leaves) is the contract's (contract/stream_line.hpp has its keys); this file picks the
+// participant's stream (main_stream()) and fills it in.
 #pragma once
 
 #include <string>
@@ -35,8 +24,8 @@ const rfbsim::ClientStreamStatus* main_stream(const std::vector<rfbsim::ClientSt
 /// in_flight_bytes, updates_sent, updates_held, quality, quality_level, delivery_mbit and fps.
 std::string streams_json(const std::vector<rfbsim::ClientStreamStatus>& streams);
 
-/// The ready pipe's stream line for `streams`, newline included (format above); under 100 bytes, so that one
-/// write() of it to a pipe is atomic.
+/// The ready pipe's stream line for `streams` (rfbsim::contract::stream_line of the participant's stream and the
+/// number of viewers), newline included; under 100 bytes, so that one write() of it to a pipe is atomic.
 std::string stream_line(const std::vector<rfbsim::ClientStreamStatus>& streams);
 
 }  // namespace rfbsim::sim

@@ -2,6 +2,8 @@
 // StudySession: inputs, the tick, the task and the record, in that order.
 #include "app/study_session.hpp"
 
+#include "contract/ready_line.hpp"
+
 namespace rfbsim::sim {
 
 const char* viewer_role_name(ViewerRole role) { return role == ViewerRole::kWatcher ? "watcher" : "participant"; }
@@ -122,7 +124,7 @@ std::string StudySession::take_data_notice() {
   const std::optional<std::string> failure = writer_->failure();
   if (!failure) return "";
   data_notice_given_ = true;
-  return "data incomplete reason=" + *failure + "\n";
+  return contract::data_incomplete_line(*failure);
 }
 
 }  // namespace rfbsim::sim

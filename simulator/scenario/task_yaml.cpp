@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "contract/task_bounds.hpp"
 #include "scenario/scenario.hpp"
 
 namespace rfbsim::sim {
@@ -50,8 +51,10 @@ TaskStep parse_step(const YamlField& item, const std::vector<Landmark>& landmark
 TaskSpec parse_task(const YamlField& task, const std::vector<Landmark>& landmarks) {
   task.allow_only({"time_limit", "end_grace", "steps"});
   TaskSpec spec;
-  if (auto limit = task.optional("time_limit")) spec.time_limit = limit->number(1.0, 86400.0);
-  if (auto grace = task.optional("end_grace")) spec.end_grace = grace->number(0.0, 3600.0);
+  // The bounds sim_manager assumes too (a session's maximum duration must fit the task).
+  using namespace contract;
+  if (auto limit = task.optional("time_limit")) spec.time_limit = limit->number(kMinTimeLimitS, kMaxTimeLimitS);
+  if (auto grace = task.optional("end_grace")) spec.end_grace = grace->number(kMinEndGraceS, kMaxEndGraceS);
   for (const YamlField& item : task.required("steps").sequence(1, 50)) spec.steps.push_back(parse_step(item, landmarks));
   return spec;
 }

@@ -1,20 +1,27 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Stream lines from sim_rfb's ready pipe.
-#include "sessions/stream_report.hpp"
+// The ready pipe's stream line: its writer and its parser, side by side so that they keep one format.
+#include "contract/stream_line.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <set>
 
-namespace rfbsim::manager {
+namespace rfbsim::contract {
 
 namespace {
 
-constexpr std::string_view kWord = "stream";
+constexpr std::string_view kStreamWord = "stream";
+
+// `value` limited to low..high; low when it is not finite.
+double stream_clamped(double value, double low, double high) {
+  return std::isfinite(value) ? std::clamp(value, low, high) : low;
+}
 
 // A plain decimal number such as "12", "12.5" or "-1" (no exponent, no sign other than a leading '-', no
 // "inf" or "nan") within low..high.
-std::optional<double> decimal(std::string_view text, double low, double high) {
+std::optional<double> stream_decimal(std::string_view text, double low, double high) {
   if (text.empty() || text.size() > 24) return std::nullopt;
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
@@ -28,7 +35,7 @@ std::optional<double> decimal(std::string_view text, double low, double high) {
 }
 
 // A whole number of digits within low..high.
-std::optional<int> whole(std::string_view text, int low, int high) {
+std::optional<int> stream_whole(std::string_view text, int low, int high) {
   int value = 0;
   const char* end = text.data() + text.size();
   const auto [ptr, ec] = std::from_chars(text.data(), end, value);
@@ -38,19 +45,10 @@ std::optional<int> whole(std::string_view text, int low, int high) {
   return value;
 }
 
-// A codec's name: safe as a Prometheus label value, in JSON and on a page as it is.
-bool is_codec_name(std::string_view text) {
-  if (text.empty() || text.size() > 16) return false;
-  for (const char c : text) {
-    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'))) return false;
-  }
-  return true;
-}
-
 // Applies one known key's value to `report`; false when the value is bad. Unknown keys are not passed here.
-bool apply(std::string_view key, std::string_view value, StreamReport& report) {
+bool apply_stream_value(std::string_view key, std::string_view value, StreamReport& report) {
   if (key == "clients") {
-    const auto clients = whole(value, 0, 10000);
+    const auto clients = stream_whole(value, 0, kMaxStreamClients);
     if (clients) report.clients = *clients;
     return clients.has_value();
   }
@@ -60,24 +58,45 @@ bool apply(std::string_view key, std::string_view value, StreamReport& report) {
     return true;
   }
   if (key == "rtt_ms") {
-    const auto rtt = decimal(value, -1, 600000);
+    const auto rtt = stream_decimal(value, -1, kMaxStreamRttMs);
     if (!rtt || (*rtt < 0 && *rtt != -1)) return false;  // -1 alone means "not measured"
     if (*rtt >= 0) report.rtt_ms = *rtt;
     return true;
   }
   if (key == "fps") {
-    report.fps = decimal(value, 0, 1000);
+    report.fps = stream_decimal(value, 0, kMaxStreamFps);
     return report.fps.has_value();
   }
   // quality
-  report.quality = whole(value, 0, 100);
+  report.quality = stream_whole(value, 0, kMaxStreamQuality);
   return report.quality.has_value();
 }
 
 }  // namespace
 
+bool is_codec_name(std::string_view name) {
+  if (name.empty() || name.size() > 16) return false;
+  return std::all_of(name.begin(), name.end(), [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'); });
+}
+
+std::string stream_line(const StreamReport& report) {
+  const int clients = std::clamp(report.clients, 0, kMaxStreamClients);
+  if (clients == 0) return "stream clients=0\n";
+  // Every value bounded, so that the line stays short.
+  std::string line = "stream";
+  if (is_codec_name(report.codec)) line += " codec=" + report.codec;
+  char rtt[32] = " rtt_ms=-1";
+  if (report.rtt_ms) std::snprintf(rtt, sizeof rtt, " rtt_ms=%.1f", stream_clamped(*report.rtt_ms, 0, kMaxStreamRttMs));
+  char rest[64];
+  std::snprintf(rest, sizeof rest, " fps=%.1f quality=%d clients=%d\n",
+                stream_clamped(report.fps.value_or(0), 0, kMaxStreamFps),
+                std::clamp(report.quality.value_or(0), 0, kMaxStreamQuality), clients);
+  return line + rtt + rest;
+}
+
 bool is_stream_line(std::string_view line) {
-  return line.substr(0, kWord.size()) == kWord && (line.size() == kWord.size() || line[kWord.size()] == ' ');
+  return line.substr(0, kStreamWord.size()) == kStreamWord &&
+         (line.size() == kStreamWord.size() || line[kStreamWord.size()] == ' ');
 }
 
 StreamParse parse_stream_line(std::string_view line) {
@@ -90,7 +109,7 @@ StreamParse parse_stream_line(std::string_view line) {
   StreamReport report;
   std::set<std::string_view> seen;
   // Pairs are separated by spaces; runs of spaces and a trailing carriage return are let pass.
-  std::string_view rest = line.substr(kWord.size());
+  std::string_view rest = line.substr(kStreamWord.size());
   if (!rest.empty() && rest.back() == '\r') rest.remove_suffix(1);
   while (!rest.empty()) {
     if (rest.front() == ' ') {
@@ -111,7 +130,7 @@ StreamParse parse_stream_line(std::string_view line) {
       return out;
     }
     if (known.count(key) == 0) continue;  // a newer sim_rfb's: ignored
-    if (!apply(key, value, report)) {
+    if (!apply_stream_value(key, value, report)) {
       out.error = "bad value '" + std::string(value.substr(0, 32)) + "' for " + std::string(key);
       return out;
     }
@@ -124,4 +143,4 @@ StreamParse parse_stream_line(std::string_view line) {
   return out;
 }
 
-}  // namespace rfbsim::manager
+}  // namespace rfbsim::contract

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Reading ScenarioFacts from the offered scenario files.
-#include "config/scenario_facts.hpp"
+// Reading ScenarioFacts (what sim_manager needs) from scenario files.
+#include "scenario/scenario_facts.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -10,9 +10,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "admission/start_request.hpp"
+#include "contract/task_bounds.hpp"
+#include "contract/validators.hpp"
 
-namespace rfbsim::manager {
+namespace rfbsim::sim {
 
 namespace {
 
@@ -76,7 +77,7 @@ std::optional<ScenarioFacts> parse_scenario_facts(const std::string& text, const
     }
     for (const auto& spawn : spawns) {
       // A name no link can carry (not an identifier) is sim_rfb's business, not a reason to stop the manager.
-      if (!spawn.first.IsScalar() || !is_identifier(spawn.first.Scalar())) continue;
+      if (!spawn.first.IsScalar() || !contract::is_identifier(spawn.first.Scalar())) continue;
       facts.spawns.push_back(spawn.first.Scalar());
     }
   }
@@ -91,8 +92,10 @@ std::optional<ScenarioFacts> parse_scenario_facts(const std::string& text, const
       return std::nullopt;
     }
     facts.has_task = true;
-    if (!read_seconds(task, "time_limit", 1.0, 86400.0, file, facts.time_limit_s, error) ||
-        !read_seconds(task, "end_grace", 0.0, 3600.0, file, facts.end_grace_s, error)) {
+    if (!read_seconds(task, "time_limit", contract::kMinTimeLimitS, contract::kMaxTimeLimitS, file, facts.time_limit_s,
+                      error) ||
+        !read_seconds(task, "end_grace", contract::kMinEndGraceS, contract::kMaxEndGraceS, file, facts.end_grace_s,
+                      error)) {
       return std::nullopt;
     }
   }
@@ -137,4 +140,4 @@ std::vector<ScenarioFacts> load_scenario_facts(const std::vector<std::string>& e
   return all;
 }
 
-}  // namespace rfbsim::manager
+}  // namespace rfbsim::sim

@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// sim_rfb's stream lines as the manager reads them: every key, unknown ones ignored, bad ones refused whole.
+// The ready pipe's stream line: every key read, unknown ones ignored, bad ones refused whole, and what the writer
+// writes read back as it was.
 #include <catch2/catch.hpp>
 
-#include "sessions/stream_report.hpp"
+#include "contract/stream_line.hpp"
 
-using rfbsim::manager::is_stream_line;
-using rfbsim::manager::parse_stream_line;
-using rfbsim::manager::StreamParse;
+using rfbsim::contract::is_stream_line;
+using rfbsim::contract::parse_stream_line;
+using rfbsim::contract::StreamParse;
 
 namespace {
 
@@ -114,4 +115,34 @@ TEST_CASE("arbitrary bytes never crash the parser") {
     }
   }
   CHECK(parsed > 0);
+}
+
+TEST_CASE("the writer gives sim_rfb's exact bytes") {
+  using rfbsim::contract::StreamReport;
+  using rfbsim::contract::stream_line;
+  CHECK(stream_line(StreamReport{}) == "stream clients=0\n");
+  CHECK(stream_line(StreamReport{1, "tight", 12.54, 29.76, 80}) ==
+        "stream codec=tight rtt_ms=12.5 fps=29.8 quality=80 clients=1\n");
+  // Unmeasured round trip, no codec name, then values beyond their bounds: clamped, never a longer line.
+  CHECK(stream_line(StreamReport{2, "", std::nullopt, 0.0, 60}) == "stream rtt_ms=-1 fps=0.0 quality=60 clients=2\n");
+  CHECK(stream_line(StreamReport{123456, "Not A Codec", 1e12, 1.0 / 0.0, 500}) ==
+        "stream rtt_ms=600000.0 fps=0.0 quality=100 clients=9999\n");
+}
+
+TEST_CASE("what the writer writes reads back as it was") {
+  using rfbsim::contract::StreamReport;
+  for (const StreamReport& written : {StreamReport{1, "h264", 52.3, 29.7, 80}, StreamReport{3, "", std::nullopt, 0.5, 1},
+                                      StreamReport{9999, "tight", 0.0, 1000.0, 100}}) {
+    std::string line = rfbsim::contract::stream_line(written);
+    REQUIRE(line.back() == '\n');
+    line.pop_back();
+    const StreamParse read = parse_stream_line(line);
+    REQUIRE(read.report);
+    CHECK(read.report->clients == written.clients);
+    CHECK(read.report->codec == written.codec);
+    CHECK(read.report->rtt_ms == written.rtt_ms);
+    CHECK(read.report->fps == written.fps);
+    CHECK(read.report->quality == written.quality);
+  }
+  CHECK(parse_stream_line("stream clients=10000").report == std::nullopt);  // the writer's bound is the reader's
 }
