@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_cli.hpp"
 #include "bench_util.hpp"
 #include "cluster_hop.hpp"
 #include "cluster_targets.hpp"
@@ -36,27 +37,20 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag == "--help" || flag == "-h") {
-      std::printf("bench_cluster [--hosts N] [--slots N] [--calls N] [--uids N] [--fault-every N] [--interval-ms N]\n"
-                  "              [--seed N] [--requests N] [--frames N] [--only targets|hop]\n");
-      std::exit(0);
-    }
-    if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
-    const std::string value = argv[++i];
-    if (flag == "--hosts") options.hosts = bench::parse_int(value, 2, 32, flag);
-    else if (flag == "--slots") options.slots = bench::parse_int(value, 1, 64, flag);
-    else if (flag == "--calls") options.targets.calls = bench::parse_int(value, 1, 1000000, flag);
-    else if (flag == "--uids") options.targets.uids = bench::parse_int(value, 1, 1000000, flag);
-    else if (flag == "--fault-every") options.targets.fault_every = bench::parse_int(value, 2, 1000000, flag);
-    else if (flag == "--interval-ms") options.targets.interval_ms = bench::parse_int(value, 0, 60000, flag);
-    else if (flag == "--seed") options.targets.seed = static_cast<unsigned>(bench::parse_int(value, 0, 1 << 30, flag));
-    else if (flag == "--requests") options.hop.requests = bench::parse_int(value, 1, 1000000, flag);
-    else if (flag == "--frames") options.hop.frames = bench::parse_int(value, 1, 1000000, flag);
-    else if (flag == "--only" && (value == "targets" || value == "hop")) options.only = value;
-    else throw std::invalid_argument("unknown option " + flag + " " + value);
-  }
+  bench::CommandLine cli("bench_cluster",
+                         "sim_manager hosts behind HAProxy: the cluster targets over scripted /start calls with hosts\n"
+                         "killed, restarted and drained; the balancer's own hop.");
+  cli.number("--hosts", options.hosts, 2, 32, "sim_manager hosts");
+  cli.number("--slots", options.slots, 1, 64, "sessions per host");
+  cli.number("--calls", options.targets.calls, 1, 1000000, "/start calls");
+  cli.number("--uids", options.targets.uids, 1, 1000000, "participants calling");
+  cli.number("--fault-every", options.targets.fault_every, 2, 1000000, "calls between faults");
+  cli.number("--interval-ms", options.targets.interval_ms, 0, 60000, "ms between calls");
+  cli.number("--seed", options.targets.seed, 0U, 1U << 30, "the calls' seed");
+  cli.number("--requests", options.hop.requests, 1, 1000000, "requests timed on each path");
+  cli.number("--frames", options.hop.frames, 1, 1000000, "frames timed on each path");
+  bench::one_of(cli.app().add_option("--only", options.only, "run one part only"), {"targets", "hop"});
+  cli.parse(argc, argv);
   options.targets.slots_per_host = options.slots;
   return options;
 }

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "app/simulation.hpp"
+#include "bench_cli.hpp"
 #include "bench_util.hpp"
 #include "render/gl_renderer.hpp"
 #include "render/scene_builder.hpp"
@@ -52,44 +53,21 @@ struct Options {
   std::string egl_platform = "auto";
 };
 
-constexpr const char* kUsage =
-    "usage: bench_frame [--frames N] [--warmup N] [--ticks-per-frame N] [--sizes WxH,...]\n"
-    "                   [--cases walk,turn,idle] [--quality Q,...] [--egl-platform auto|device|surfaceless]\n"
-    "Times render, read-back, tile damage and one real libvncserver update per frame of the demo world.\n"
-    "The first quality is the one the end-to-end frames/s uses.\n";
-
 Options parse_options(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    }
-    if (i + 1 >= argc) throw std::invalid_argument("option " + arg + " needs a value");
-    const std::string value = argv[++i];
-    if (arg == "--frames") {
-      o.frames = bench::parse_int(value, 1, 1000000, arg);
-    } else if (arg == "--warmup") {
-      o.warmup = bench::parse_int(value, 1, 100000, arg);
-    } else if (arg == "--ticks-per-frame") {
-      o.ticks_per_frame = bench::parse_int(value, 1, 1000, arg);
-    } else if (arg == "--sizes") {
-      o.sizes = bench::parse_sizes(value);
-    } else if (arg == "--cases") {
-      o.cases = bench::split_list(value);
-      for (const auto& c : o.cases) {
-        if (c != "walk" && c != "turn" && c != "idle") throw std::invalid_argument("unknown case '" + c + "'");
-      }
-    } else if (arg == "--quality") {
-      o.qualities.clear();
-      for (const auto& item : bench::split_list(value)) o.qualities.push_back(bench::parse_int(item, 1, 100, arg));
-    } else if (arg == "--egl-platform") {
-      o.egl_platform = value;
-    } else {
-      throw std::invalid_argument("unknown option " + arg);
-    }
-  }
+  bench::CommandLine cli("bench_frame",
+                         "Times render, read-back, tile damage and one real libvncserver update per frame of the demo "
+                         "world.\nThe first quality is the one the end-to-end frames/s uses.");
+  cli.number("--frames", o.frames, 1, 1000000, "frames measured per case");
+  cli.number("--warmup", o.warmup, 1, 100000, "frames run before measuring");
+  cli.number("--ticks-per-frame", o.ticks_per_frame, 1, 1000, "simulation ticks between frames");
+  cli.list("--sizes", o.sizes, [](const std::string& item) { return bench::parse_sizes(item).at(0); },
+           "frame sizes, WxH each");
+  cli.list("--cases", o.cases, bench::item_of({"walk", "turn", "idle"}, "--cases"),
+           "what the avatar does: walk, turn, idle");
+  cli.list("--quality", o.qualities, bench::int_in(1, 100, "--quality"), "JPEG qualities");
+  bench::one_of(cli.text("--egl-platform", o.egl_platform, "EGL platform"), {"auto", "device", "surfaceless"});
+  cli.parse(argc, argv);
   return o;
 }
 
@@ -324,7 +302,7 @@ int main(int argc, char** argv) {
   try {
     return run(parse_options(argc, argv));
   } catch (const std::invalid_argument& error) {
-    std::fprintf(stderr, "bench_frame: %s\n%s", error.what(), kUsage);
+    std::fprintf(stderr, "bench_frame: %s (--help shows the usage)\n", error.what());
     return 2;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "bench_frame: error: %s\n", error.what());

@@ -25,6 +25,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_cli.hpp"
 #include "bench_util.hpp"
 #include "rfb_test_client.hpp"
 #include "sim_process.hpp"
@@ -54,47 +55,22 @@ struct Options {
   std::string sim_log = (std::filesystem::temp_directory_path() / "rfbsim_bench_latency_sim.log").string();
 };
 
-constexpr const char* kUsage =
-    "usage: bench_latency [--samples M] [--sizes WxH,...] [--fps F,...] [--threshold MAD] [--settle-ms MS]\n"
-    "                     [--key CHAR] [--sim PATH] [--sim-log PATH]\n"
-    "Measures key press to visible update against a real sim_rfb over loopback (libvncclient).\n";
-
 Options parse_options(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    }
-    if (i + 1 >= argc) throw std::invalid_argument("option " + arg + " needs a value");
-    const std::string value = argv[++i];
-    if (arg == "--samples") {
-      o.samples = bench::parse_int(value, 1, 100000, arg);
-    } else if (arg == "--sizes") {
-      o.sizes = bench::parse_sizes(value);
-    } else if (arg == "--fps") {
-      o.fps.clear();
-      for (const auto& item : bench::split_list(value)) o.fps.push_back(bench::parse_int(item, 1, 240, arg));
-    } else if (arg == "--threshold") {
-      try {
-        o.threshold = std::stod(value);
-      } catch (const std::exception&) {
-        throw std::invalid_argument("--threshold: '" + value + "' is not a number");
-      }
-    } else if (arg == "--settle-ms") {
-      o.settle_ms = bench::parse_int(value, 10, 10000, arg);
-    } else if (arg == "--key") {
-      if (value.size() != 1) throw std::invalid_argument("--key takes one character");
-      o.key = static_cast<unsigned char>(value[0]);
-    } else if (arg == "--sim") {
-      o.sim = value;
-    } else if (arg == "--sim-log") {
-      o.sim_log = value;
-    } else {
-      throw std::invalid_argument("unknown option " + arg);
-    }
-  }
+  bench::CommandLine cli("bench_latency",
+                         "Measures key press to visible update against a real sim_rfb over loopback (libvncclient).");
+  cli.number("--samples", o.samples, 1, 100000, "key presses per size and frame rate");
+  cli.list("--sizes", o.sizes, [](const std::string& item) { return bench::parse_sizes(item).at(0); },
+           "frame sizes, WxH each");
+  cli.list("--fps", o.fps, bench::int_in(1, 240, "--fps"), "frame rates");
+  cli.app().add_option("--threshold", o.threshold, "MAD above which a frame shows the key's effect")
+      ->type_name("MAD")->capture_default_str();
+  cli.number("--settle-ms", o.settle_ms, 10, 10000, "ms to wait between presses");
+  cli.value("--key", o.key, bench::parse_key, "the key pressed (one character)")
+      ->type_name("CHAR")->default_str(std::string(1, static_cast<char>(o.key)));
+  cli.text("--sim", o.sim, "the sim_rfb to run");
+  cli.text("--sim-log", o.sim_log, "where sim_rfb's output goes");
+  cli.parse(argc, argv);
   return o;
 }
 
@@ -211,7 +187,7 @@ int main(int argc, char** argv) {
   try {
     return run(parse_options(argc, argv));
   } catch (const std::invalid_argument& error) {
-    std::fprintf(stderr, "bench_latency: %s\n%s", error.what(), kUsage);
+    std::fprintf(stderr, "bench_latency: %s (--help shows the usage)\n", error.what());
     return 2;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "bench_latency: error: %s\n", error.what());

@@ -38,6 +38,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_cli.hpp"
 #include "bench_util.hpp"
 #include "http_client.hpp"
 #include "manager_abuse.hpp"
@@ -91,75 +92,44 @@ struct Options {
   bench::AbuseOptions abuse_options;
 };
 
-constexpr const char* kUsage =
-    "usage: bench_manager [--sessions N] [--scenario NAME] [--seconds S] [--max-capacity N] [--skip-capacity]\n"
-    "                     [--manager PATH] [--log PATH]\n"
-    "       bench_manager --soak MINUTES [--sessions-per-minute N] [--soak-max-sessions N] [--watch-seconds S]\n"
-    "       bench_manager --abuse [--abuse-repetitions N] [--abuse-seconds S] [--half-open N]\n"
-    "                     [--abuse-from ADDR] [--storm-per-second N]\n"
-    "Measures sim_manager: link to first frame, the relay's cost per update, sessions at 20 fps (loopback).\n"
-    "--soak cycles sessions through the relay for MINUTES (default 10 per minute, 4 at once, 5 s of frames each)\n"
-    "and samples the manager's RSS and descriptors every 10 s. --abuse compares a participant's first frame and\n"
-    "frame rate on an idle manager with the same while ADDR (default 127.0.0.2) holds N (2000) half-open sockets\n"
-    "and hammers /start. Both can be given (soak first); either replaces the three default measurements.\n";
-
 Options parse_options(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    }
-    if (arg == "--skip-capacity") {
-      o.skip_capacity = true;
-      continue;
-    }
-    if (arg == "--abuse") {
-      o.abuse = true;
-      continue;
-    }
-    if (i + 1 >= argc) throw std::invalid_argument("option " + arg + " needs a value");
-    const std::string value = argv[++i];
-    if (arg == "--sessions") {
-      o.sessions = bench::parse_int(value, 1, 1000, arg);
-    } else if (arg == "--scenario") {
-      o.scenario = value;
-    } else if (arg == "--seconds") {
-      o.seconds = bench::parse_int(value, 2, 3600, arg);
-    } else if (arg == "--max-capacity") {
-      o.max_capacity = bench::parse_int(value, 1, 64, arg);
-    } else if (arg == "--manager") {
-      o.manager = value;
-    } else if (arg == "--log") {
-      o.log = value;
-    } else if (arg == "--soak") {
-      o.soak = true;
-      o.soak_options.minutes = bench::parse_int(value, 1, 24 * 60, arg);
-    } else if (arg == "--sessions-per-minute") {
-      o.soak_options.sessions_per_minute = bench::parse_int(value, 1, 600, arg);
-    } else if (arg == "--soak-max-sessions") {
-      o.soak_options.max_sessions = bench::parse_int(value, 1, 64, arg);
-    } else if (arg == "--watch-seconds") {
-      o.soak_options.watch_seconds = bench::parse_int(value, 1, 600, arg);
-    } else if (arg == "--abuse-repetitions") {
-      o.abuse_options.repetitions = bench::parse_int(value, 1, 100, arg);
-    } else if (arg == "--abuse-seconds") {
-      o.abuse_options.seconds = bench::parse_int(value, 1, 600, arg);
-    } else if (arg == "--half-open") {
-      o.abuse_options.half_open = bench::parse_int(value, 0, 60000, arg);
-    } else if (arg == "--abuse-from") {
-      in_addr parsed{};
-      if (::inet_pton(AF_INET, value.c_str(), &parsed) != 1) {
-        throw std::invalid_argument(arg + ": '" + value + "' is not an IPv4 address");
-      }
-      o.abuse_options.from = value;
-    } else if (arg == "--storm-per-second") {
-      o.abuse_options.storm_per_second = bench::parse_int(value, 0, 1000, arg);
-    } else {
-      throw std::invalid_argument("unknown option " + arg);
-    }
-  }
+  bench::CommandLine cli(
+      "bench_manager",
+      "Measures sim_manager: link to first frame, the relay's cost per update, sessions at 20 fps (loopback).\n"
+      "--soak cycles sessions through the relay for MINUTES and samples the manager's RSS and descriptors every\n"
+      "10 s. --abuse compares a participant's first frame and frame rate on an idle manager with the same while\n"
+      "--abuse-from holds --half-open half-open sockets and hammers /start. Both can be given (soak first);\n"
+      "either replaces the three default measurements.");
+  cli.number("--sessions", o.sessions, 1, 1000, "sessions at once");
+  cli.text("--scenario", o.scenario, "the sessions' scenario");
+  cli.number("--seconds", o.seconds, 2, 3600, "seconds of frames per measurement");
+  cli.number("--max-capacity", o.max_capacity, 1, 64, "the most sessions the capacity table tries");
+  cli.flag("--skip-capacity", o.skip_capacity, "leave the capacity table out");
+  cli.text("--manager", o.manager, "the sim_manager to run");
+  cli.text("--log", o.log, "where sim_manager's output goes");
+  cli.value("--soak", o.soak_options.minutes,
+            [](const std::string& text) { return static_cast<double>(bench::parse_int(text, 1, 24 * 60, "--soak")); },
+            "run the soak for MINUTES (1..1440)")
+      ->type_name("MINUTES")->default_str(bench::fixed(o.soak_options.minutes, 0));
+  cli.number("--sessions-per-minute", o.soak_options.sessions_per_minute, 1, 600, "the soak's sessions per minute");
+  cli.number("--soak-max-sessions", o.soak_options.max_sessions, 1, 64, "the soak's sessions at once");
+  cli.number("--watch-seconds", o.soak_options.watch_seconds, 1, 600, "seconds of frames per soak session");
+  cli.flag("--abuse", o.abuse, "run the abuse comparison");
+  cli.number("--abuse-repetitions", o.abuse_options.repetitions, 1, 100, "abuse comparisons");
+  cli.number("--abuse-seconds", o.abuse_options.seconds, 1, 600, "seconds per abuse measurement");
+  cli.number("--half-open", o.abuse_options.half_open, 0, 60000, "half-open sockets the abuser holds");
+  cli.text("--abuse-from", o.abuse_options.from, "the abuser's IPv4 address")
+      ->type_name("ADDR")
+      ->check(bench::satisfies(
+          [](const std::string& text) {
+            in_addr parsed{};
+            return ::inet_pton(AF_INET, text.c_str(), &parsed) == 1;
+          },
+          "an IPv4 address"));
+  cli.number("--storm-per-second", o.abuse_options.storm_per_second, 0, 1000, "the abuser's /start calls per second");
+  cli.parse(argc, argv);
+  o.soak = cli.given("--soak");
   return o;
 }
 
@@ -535,7 +505,7 @@ int main(int argc, char** argv) {
   try {
     return run(parse_options(argc, argv));
   } catch (const std::invalid_argument& error) {
-    std::fprintf(stderr, "bench_manager: %s\n%s", error.what(), kUsage);
+    std::fprintf(stderr, "bench_manager: %s (--help shows the usage)\n", error.what());
     return 2;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "bench_manager: error: %s\n", error.what());

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_cli.hpp"
 #include "bench_util.hpp"
 #include "robot/social_metrics.hpp"
 #include "scenario/robot_params_yaml.hpp"
@@ -39,28 +40,18 @@ struct Options {
   bool compare = false;
 };
 
-constexpr const char* kUsage = "usage: bench_nav [--trials N] [--first-seed S] [--nav FILE] [--before | --compare]";
-
 Options parse(int argc, char** argv) {
   Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if ((arg == "--trials" || arg == "--first-seed") && i + 1 < argc) {
-      const int value = bench::parse_int(argv[++i], arg == "--trials" ? 1 : 0, 100000, arg);
-      (arg == "--trials" ? options.trials : options.first_seed) = value;
-    } else if (arg == "--nav" && i + 1 < argc) {
-      options.nav_file = argv[++i];
-    } else if (arg == "--before") {
-      options.before = true;
-    } else if (arg == "--compare") {
-      options.compare = true;
-    } else {
-      throw std::invalid_argument("unknown argument '" + arg + "' (" + kUsage + ")");
-    }
-  }
-  if (options.before && options.compare) {
-    throw std::invalid_argument(std::string("--before or --compare, not both (") + kUsage + ")");
-  }
+  bench::CommandLine cli("bench_nav",
+                         "The robot stack's cost per stage and the navigation metrics of the warehouse trials.");
+  cli.number("--trials", options.trials, 1, 100000, "warehouse trials");
+  cli.number("--first-seed", options.first_seed, 0, 100000, "the first trial's seed");
+  cli.app().add_option("--nav", options.nav_file, "navigation settings (YAML) instead of the scenario's")
+      ->type_name("FILE")->check(bench::non_empty());
+  cli.flag("--before", options.before, "the settings from before issue 19");
+  cli.flag("--compare", options.compare, "before issue 19 and now, side by side");
+  cli.parse(argc, argv);
+  if (options.before && options.compare) throw std::invalid_argument("--before or --compare, not both");
   return options;
 }
 

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_cli.hpp"
 #include "bench_util.hpp"
 #include "manager_process.hpp"
 #include "network_browser.hpp"
@@ -66,16 +67,6 @@ struct Options {
   std::string source_dir = RFBSIM_BENCH_SOURCE_DIR;
 };
 
-constexpr const char* kUsage =
-    "usage: bench_network [--rtts MS,...] [--caps none|MBIT,...] [--clients fbur,cu,h264] [--paths direct,manager]\n"
-    "                     [--seconds S] [--warm-up S] [--presses N] [--threshold MAD] [--seed N]\n"
-    "                     [--long-seconds S] [--browser-rtts none|MS,...] [--codec-frames N] [--mad-trace]\n"
-    "                     [--key CHAR]\n"
-    "                     [--sim PATH] [--manager PATH] [--node PATH] [--source-dir DIR] [--log PATH]\n"
-    "Frames, bytes and key-to-picture latency of the warehouse walking at 1280x720 through an emulated link.\n"
-    "--long-seconds 0, --browser-rtts none and --codec-frames 0 skip parts 2, 3 and 4. --mad-trace prints each\n"
-    "press's MAD series (to choose --threshold; --key x, a key the avatar ignores, gives the walk alone).\n";
-
 std::vector<int> parse_rtts(const std::string& text) {
   std::vector<int> out;
   if (text == "none") return out;
@@ -90,64 +81,43 @@ Options parse_options(int argc, char** argv) {
   o.sim.log = (std::filesystem::temp_directory_path() / "rfbsim_bench_network.log").string();
   // In the loading area, heading north: the walk's turns to the right circle it there (radius about 2.4 m).
   o.sim.avatar_start = "10,4.5,1.5708";
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    }
-    if (arg == "--mad-trace") {
-      o.mad_trace = true;
-      continue;
-    }
-    if (i + 1 >= argc) throw std::invalid_argument("option " + arg + " needs a value");
-    const std::string value = argv[++i];
-    if (arg == "--rtts") {
-      o.rtts = parse_rtts(value);
-    } else if (arg == "--caps") {
-      o.caps.clear();
-      for (const std::string& item : bench::split_list(value)) {
-        o.caps.push_back(item == "none" ? 0.0 : bench::parse_int(item, 1, 10000, "cap"));
-      }
-    } else if (arg == "--clients") {
-      o.clients.clear();
-      for (const std::string& item : bench::split_list(value)) o.clients.push_back(bench::parse_client(item));
-    } else if (arg == "--paths") {
-      o.paths.clear();
-      for (const std::string& item : bench::split_list(value)) o.paths.push_back(bench::parse_path(item));
-    } else if (arg == "--seconds") {
-      o.seconds = bench::parse_int(value, 1, 3600, arg);
-    } else if (arg == "--warm-up") {
-      o.warm_up = bench::parse_int(value, 0, 600, arg);
-    } else if (arg == "--presses") {
-      o.presses = bench::parse_int(value, 0, 10000, arg);
-    } else if (arg == "--threshold") {
-      o.threshold = bench::parse_int(value, 1, 255, arg);
-    } else if (arg == "--seed") {
-      o.sim.seed = static_cast<std::uint64_t>(bench::parse_int(value, 0, 1000000000, arg));
-    } else if (arg == "--long-seconds") {
-      o.long_seconds = bench::parse_int(value, 0, 3600, arg);
-    } else if (arg == "--browser-rtts") {
-      o.browser_rtts = parse_rtts(value);
-    } else if (arg == "--codec-frames") {
-      o.codec_frames = bench::parse_int(value, 0, 100000, arg);
-    } else if (arg == "--sim") {
-      o.sim.sim = value;
-    } else if (arg == "--manager") {
-      o.sim.manager = value;
-    } else if (arg == "--source-dir") {
-      o.source_dir = value;
-    } else if (arg == "--key") {
-      if (value.size() != 1) throw std::invalid_argument("--key takes one character");
-      o.turn_key = static_cast<unsigned char>(value[0]);
-    } else if (arg == "--node") {
-      o.sim.node = value;
-    } else if (arg == "--log") {
-      o.sim.log = value;
-    } else {
-      throw std::invalid_argument("unknown option " + arg);
-    }
-  }
+  bench::CommandLine cli(
+      "bench_network",
+      "Frames, bytes and key-to-picture latency of the warehouse walking at 1280x720 through an emulated link.\n"
+      "--long-seconds 0, --browser-rtts none and --codec-frames 0 skip parts 2, 3 and 4. --mad-trace prints each\n"
+      "press's MAD series (to choose --threshold; --key x, a key the avatar ignores, gives the walk alone).");
+  const auto ms = [](int value) { return std::to_string(value); };
+  cli.value("--rtts", o.rtts, parse_rtts, "round-trip times in ms (MS,... or none)")
+      ->type_name("MS,...")->default_str(bench::joined(o.rtts, ms));
+  cli.list("--caps", o.caps,
+           [](const std::string& item) {
+             return item == "none" ? 0.0 : static_cast<double>(bench::parse_int(item, 1, 10000, "cap"));
+           },
+           [](double cap) { return cap == 0 ? std::string("none") : bench::fixed(cap, 0); },
+           "link capacities in Mbit/s (none: no cap)");
+  cli.list("--clients", o.clients, bench::parse_client, bench::client_name, "clients: fbur, cu, h264");
+  cli.list("--paths", o.paths, bench::parse_path, bench::path_name, "paths: direct, manager");
+  cli.number("--seconds", o.seconds, 1, 3600, "seconds per measurement");
+  cli.number("--warm-up", o.warm_up, 0, 600, "seconds before measuring");
+  cli.number("--presses", o.presses, 0, 10000, "key presses per measurement");
+  cli.value("--threshold", o.threshold,
+            [](const std::string& text) { return static_cast<double>(bench::parse_int(text, 1, 255, "--threshold")); },
+            "MAD above which a frame shows the key's effect (1..255)")
+      ->type_name("MAD")->default_str(bench::fixed(o.threshold, 0));
+  cli.number("--seed", o.sim.seed, std::uint64_t{0}, std::uint64_t{1000000000}, "sim_rfb's seed: the same crowd in every cell");
+  cli.number("--long-seconds", o.long_seconds, 0, 3600, "seconds of the lag check (0: none)");
+  cli.value("--browser-rtts", o.browser_rtts, parse_rtts, "noVNC's round-trip times in ms (MS,... or none)")
+      ->type_name("MS,...")->default_str(bench::joined(o.browser_rtts, ms));
+  cli.number("--codec-frames", o.codec_frames, 0, 100000, "frames of the codec tables (0: none)");
+  cli.flag("--mad-trace", o.mad_trace, "print each press's MAD series");
+  cli.value("--key", o.turn_key, bench::parse_key, "the key pressed (one character)")
+      ->type_name("CHAR")->default_str(std::string(1, static_cast<char>(o.turn_key)));
+  cli.text("--sim", o.sim.sim, "the sim_rfb to run");
+  cli.text("--manager", o.sim.manager, "the sim_manager to run");
+  cli.text("--node", o.sim.node, "the node that runs the browser part");
+  cli.text("--source-dir", o.source_dir, "rfbsim's source tree (for the browser part's scripts)");
+  cli.text("--log", o.sim.log, "where the programs' output goes");
+  cli.parse(argc, argv);
   return o;
 }
 
@@ -292,7 +262,7 @@ int main(int argc, char** argv) {
   try {
     return run(parse_options(argc, argv));
   } catch (const std::invalid_argument& error) {
-    std::fprintf(stderr, "bench_network: %s\n%s", error.what(), kUsage);
+    std::fprintf(stderr, "bench_network: %s (--help shows the usage)\n", error.what());
     return 2;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "bench_network: error: %s\n", error.what());

@@ -19,6 +19,7 @@
 
 #include "app/session_setup.hpp"
 #include "app/study_session.hpp"
+#include "bench_cli.hpp"
 #include "bench_util.hpp"
 #include "record/session_writer.hpp"
 #include "replay_job.hpp"
@@ -139,24 +140,14 @@ void run(const Options& options) {
 
 Options parse(int argc, char** argv) {
   Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
-    const std::string value = argv[++i];
-    if (arg == "--seconds") {
-      options.seconds = bench::parse_int(value, 1, 3600, arg);
-    } else if (arg == "--runs") {
-      options.runs = bench::parse_int(value, 1, 100, arg);
-    } else if (arg == "--sessions") {
-      options.sessions = bench::parse_int(value, 1, 100, arg);
-    } else if (arg == "--size") {
-      options.size = bench::parse_sizes(value).at(0);
-    } else if (arg == "--scenario") {
-      options.scenario = value;
-    } else {
-      throw std::invalid_argument("unknown argument " + arg);
-    }
-  }
+  bench::CommandLine cli("bench_replay",
+                         "sim_replay: replay speed with and without video (both views), render and encode per frame.");
+  cli.number("--seconds", options.seconds, 1, 3600, "simulated seconds per session");
+  cli.number("--runs", options.runs, 1, 100, "replays per session and mode");
+  cli.number("--sessions", options.sessions, 1, 100, "sessions recorded");
+  cli.size("--size", options.size, "the recorded frame: the video's size");
+  cli.text("--scenario", options.scenario, "the sessions' scenario");
+  cli.parse(argc, argv);
   return options;
 }
 

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_cli.hpp"
 #include "bench_util.hpp"
 #include "manager_probe.hpp"
 #include "manager_process.hpp"
@@ -61,58 +62,33 @@ struct Options {
   std::string log = (std::filesystem::temp_directory_path() / "rfbsim_bench_session_kinds.log").string();
 };
 
-constexpr const char* kUsage =
-    "usage: bench_session_kinds [--size WxH] [--runs N] [--seconds S] [--kinds sim_rfb,rfb,x11]\n"
-    "                           [--manager PATH] [--mujoco PATH] [--x11-program PATH] [--xvnc PATH] [--log PATH]\n"
-    "Per session kind at one picture size (default 640x480): start-up to first frame through sim_manager, then\n"
-    "S seconds (default 10) of a client taking updates while the session's process group is read from /proc\n"
-    "(CPU cores, RSS, processes), R runs (default 5) each. Kinds: sim_rfb (the lab scenario), rfb (mujoco_rfb,\n"
-    "default the one built here), x11 (the X11 program, default /usr/bin/glxgears, under Xvnc). sim_manager's\n"
-    "and its sessions' output go to the log (default $TMPDIR/rfbsim_bench_session_kinds.log).\n";
-
 Options parse_options(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    }
-    if (i + 1 >= argc) throw std::invalid_argument("option " + arg + " needs a value");
-    const std::string value = argv[++i];
-    if (arg == "--size") {
-      const std::vector<bench::Size> sizes = bench::parse_sizes(value);
-      if (sizes.size() != 1) throw std::invalid_argument("--size takes one WIDTHxHEIGHT, not '" + value + "'");
-      o.size = sizes.front();
+  bench::CommandLine cli(
+      "bench_session_kinds",
+      "Per session kind at one picture size: start-up to first frame through sim_manager, then S seconds of a\n"
+      "client taking updates while the session's process group is read from /proc (CPU cores, RSS, processes),\n"
+      "R runs each. Kinds: sim_rfb (the lab scenario), rfb (mujoco_rfb), x11 (the X11 program under Xvnc).\n"
+      "sim_manager's and its sessions' output go to the log.");
+  cli.size("--size", o.size, "the picture's size, 160x120 .. 3840x2160")
       // sim_rfb's and mujoco_rfb's own bounds, so that a size one of them refuses fails here, clearly.
-      if (o.size.width < 160 || o.size.width > 3840 || o.size.height < 120 || o.size.height > 2160) {
-        throw std::invalid_argument("--size " + value + " is outside 160x120 .. 3840x2160");
-      }
-    } else if (arg == "--runs") {
-      o.runs = bench::parse_int(value, 1, 100, arg);
-    } else if (arg == "--seconds") {
-      o.seconds = bench::parse_int(value, 1, 600, arg);
-    } else if (arg == "--kinds") {
-      o.kinds = bench::split_list(value);
-      for (const std::string& kind : o.kinds) {
-        if (kind != "sim_rfb" && kind != "rfb" && kind != "x11") {
-          throw std::invalid_argument("--kinds: '" + kind + "' is not sim_rfb, rfb or x11");
-        }
-      }
-    } else if (arg == "--manager") {
-      o.manager = value;
-    } else if (arg == "--mujoco") {
-      o.mujoco = value;
-    } else if (arg == "--x11-program") {
-      o.x11_program = value;
-    } else if (arg == "--xvnc") {
-      o.xvnc = value;
-    } else if (arg == "--log") {
-      o.log = value;
-    } else {
-      throw std::invalid_argument("unknown option " + arg);
-    }
-  }
+      ->check(bench::satisfies(
+          [](const std::string& text) {
+            const std::vector<bench::Size> sizes = bench::parse_sizes(text);
+            return sizes.size() == 1 && sizes[0].width >= 160 && sizes[0].width <= 3840 && sizes[0].height >= 120 &&
+                   sizes[0].height <= 2160;
+          },
+          "one WIDTHxHEIGHT in 160x120 .. 3840x2160"));
+  cli.number("--runs", o.runs, 1, 100, "runs per kind");
+  cli.number("--seconds", o.seconds, 1, 600, "seconds measured per run");
+  cli.list("--kinds", o.kinds, bench::item_of({"sim_rfb", "rfb", "x11"}, "--kinds"),
+           "session kinds: sim_rfb, rfb, x11");
+  cli.text("--manager", o.manager, "the sim_manager to run");
+  cli.app().add_option("--mujoco", o.mujoco, "the mujoco_rfb to run (default: the one built here)")->type_name("TEXT");
+  cli.text("--x11-program", o.x11_program, "the X11 program");
+  cli.text("--xvnc", o.xvnc, "TigerVNC's Xvnc");
+  cli.text("--log", o.log, "where the output goes");
+  cli.parse(argc, argv);
   return o;
 }
 
@@ -323,7 +299,7 @@ int main(int argc, char** argv) {
   try {
     options = parse_options(argc, argv);
   } catch (const std::exception& error) {
-    std::fprintf(stderr, "bench_session_kinds: %s\n%s", error.what(), kUsage);
+    std::fprintf(stderr, "bench_session_kinds: %s (--help shows the usage)\n", error.what());
     return 2;
   }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "app/simulation.hpp"
+#include "bench_cli.hpp"
 #include "bench_util.hpp"
 #include "crowd/crowd.hpp"
 #include "physics/physics_world.hpp"
@@ -152,24 +153,15 @@ void bench_render(const Options& options) {
 
 Options parse(int argc, char** argv) {
   Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
-    const std::string value = argv[++i];
-    if (arg == "--ticks") {
-      options.ticks = bench::parse_int(value, 1, 10'000'000, arg);
-    } else if (arg == "--frames") {
-      options.frames = bench::parse_int(value, 1, 100'000, arg);
-    } else if (arg == "--size") {
-      options.size = bench::parse_sizes(value).at(0);
-    } else if (arg == "--samples") {
-      options.samples = bench::parse_int(value, 0, 16, arg);
-    } else if (arg == "--scenarios") {
-      options.scenarios = bench::split_list(value);
-    } else {
-      throw std::invalid_argument("unknown argument " + arg);
-    }
-  }
+  bench::CommandLine cli("bench_world",
+                         "The sim step per tick (crowd, physics, total) and the render per frame of the shipped scenes.");
+  cli.number("--ticks", options.ticks, 1, 10'000'000, "ticks stepped");
+  cli.number("--frames", options.frames, 1, 100'000, "frames rendered per scene");
+  cli.size("--size", options.size, "the frame's size");
+  cli.number("--samples", options.samples, 0, 16, "MSAA samples")
+      ->default_str("auto: 4 on a GPU, none on a software rasterizer");
+  cli.list("--scenarios", options.scenarios, [](const std::string& item) { return item; }, "scenes rendered");
+  cli.parse(argc, argv);
   return options;
 }
 

@@ -12,6 +12,7 @@ find_package(websocketpp CONFIG REQUIRED)            # websocketpp::websocketpp 
 find_package(Boost REQUIRED COMPONENTS system)       # websocketpp's asio transport
 find_package(OpenSSL 3 REQUIRED)                     # OpenSSL::SSL, OpenSSL::Crypto: TLS, signed links, tokens
 find_package(SQLite3 REQUIRED)                       # SQLite::SQLite3: sim_manager's session index
+find_package(CLI11 2 REQUIRED CONFIG)                # CLI11::CLI11 (header-only): every command line
 find_package(nlohmann_json 3 REQUIRED CONFIG)        # nlohmann_json::nlohmann_json: session data (record/, tools/)
 pkg_check_modules(ZSTD REQUIRED IMPORTED_TARGET libzstd)  # PkgConfig::ZSTD: session.mcap's chunks (simulator/ros/mcap)
 find_package(ZLIB REQUIRED)                          # ZLIB::ZLIB: crc32 for session.mcap's CRCs

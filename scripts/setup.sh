@@ -26,7 +26,7 @@ done
 packages=(build-essential cmake ninja-build pkg-config git
   libvncserver-dev libegl-dev libgl-dev libopengl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm-dev
   libode-dev libyaml-cpp-dev libpng-dev libeigen3-dev libwebsocketpp-dev libboost-system-dev libasio-dev catch2 libssl-dev libsqlite3-dev libzstd-dev zlib1g-dev
-  nlohmann-json3-dev libfreetype-dev fonts-dejavu-core libavcodec-dev libavformat-dev libswscale-dev libavutil-dev
+  nlohmann-json3-dev libcli11-dev libfreetype-dev fonts-dejavu-core libavcodec-dev libavformat-dev libswscale-dev libavutil-dev
   ffmpeg)
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)

@@ -15,6 +15,7 @@
 #include <string>
 #include <thread>
 
+#include <CLI/CLI.hpp>
 #include <rfbsim/offscreen_gl.hpp>
 #include <rfbsim/server.hpp>
 
@@ -42,11 +43,17 @@ void draw(int width, int height, double t) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // The command line: one optional argument, declared once (CLI11 gives --help and the errors from it).
+  CLI::App app("Serves an animated OpenGL scene to VNC and noVNC clients", "rfbsim_minimal");
+  int port = 5902;
+  app.add_option("PORT", port, "TCP port; 0 = any free one")->capture_default_str()->check(CLI::Range(0, 65535));
+  CLI11_PARSE(app, argc, argv);
+
   std::signal(SIGINT, [](int) { stop = true; });
   std::signal(SIGTERM, [](int) { stop = true; });
   try {
     rfbsim::ServerOptions options;
-    options.port = argc > 1 ? std::stoi(argv[1]) : 5902;
+    options.port = port;
     options.width = 640;
     options.height = 480;
     options.on_connect = [](const rfbsim::ClientInfo& c) { std::printf("client %d connected\n", c.id); };

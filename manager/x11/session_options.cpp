@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Flag parsing for rfbsim_x11_session: each flag once, each value checked where it is read.
+// rfbsim_x11_session's command line: each flag declared once with CLI11, from which parsing and --help follow.
 #include "session_options.hpp"
 
 #include <sys/un.h>
 
+#include <algorithm>
 #include <charconv>
-#include <set>
+
+#include "cli/command_line.hpp"
 
 namespace rfbsim::x11 {
 
@@ -13,92 +15,86 @@ namespace {
 
 constexpr int kMinSide = 16;
 constexpr int kMaxSide = 8192;
+// sun_path holds the path and its terminating NUL.
+constexpr std::size_t kMaxSocketPath = sizeof(sockaddr_un{}.sun_path) - 1;
 
-// A whole decimal number in [low, high]; false for anything else ("", "12x", "+3", overflow).
-bool parse_int(const std::string& text, int low, int high, int& out) {
+// A whole decimal side in kMinSide..kMaxSide; false for anything else ("", "12x", "+3", overflow).
+bool parse_side(const std::string& text, int& out) {
   int value = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size() || text.empty() || value < low || value > high) {
+  if (ec != std::errc() || end != text.data() + text.size() || text.empty() || value < kMinSide || value > kMaxSide) {
     return false;
   }
   out = value;
   return true;
 }
 
-// One flag's value into `options`; "" or why it is refused.
-std::string take(const std::string& flag, const std::string& value, SessionOptions& options) {
-  if (flag == "--rfb-socket") {
-    // sun_path holds the path and its terminating NUL.
-    if (value.empty() || value.size() >= sizeof(sockaddr_un{}.sun_path)) {
-      return "--rfb-socket: a path of 1 to " + std::to_string(sizeof(sockaddr_un{}.sun_path) - 1) + " bytes";
-    }
-    options.rfb_socket = value;
-  } else if (flag == "--xauthority") {
-    if (value.empty()) return "--xauthority: a path is needed";
-    options.xauthority = value;
-  } else if (flag == "--geometry") {
-    const std::size_t x = value.find('x');
-    if (x == std::string::npos || !parse_int(value.substr(0, x), kMinSide, kMaxSide, options.width) ||
-        !parse_int(value.substr(x + 1), kMinSide, kMaxSide, options.height)) {
-      return "--geometry: '" + value + "' is not WxH with each side in " + std::to_string(kMinSide) + ".." +
-             std::to_string(kMaxSide);
-    }
-  } else if (flag == "--depth") {
-    if (value != "16" && value != "24") return "--depth: '" + value + "' is not 16 or 24";
-    options.depth = value == "16" ? 16 : 24;
-  } else if (flag == "--ready-fd") {
-    // 0..2 are the standard streams, never a pipe of the manager's.
-    if (!parse_int(value, 3, 1 << 20, options.ready_fd)) return "--ready-fd: '" + value + "' is not a descriptor >= 3";
-  } else if (flag == "--xvnc") {
-    if (value.empty()) return "--xvnc: a path is needed";
-    options.xvnc = value;
-  } else {
-    return "unknown flag " + flag;
-  }
-  return "";
+// "WxH" into width and height; false when it is not that shape or a side is out of range.
+bool parse_geometry(const std::string& text, int& width, int& height) {
+  const std::size_t x = text.find('x');
+  return x != std::string::npos && parse_side(text.substr(0, x), width) && parse_side(text.substr(x + 1), height);
+}
+
+// Declares rfbsim_x11_session's flags on `app`, bound to `out`.
+void declare_session_options(CLI::App& app, ParsedOptions& out) {
+  SessionOptions& o = out.options;
+  cli::configure(app);
+  // Each flag once: a second --geometry is a mistake in the caller, not an override.
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::Throw);
+  app.description(
+      "Runs PROGRAM on a private X display served by TigerVNC's Xvnc on the unix socket PATH (mode 0600),\n"
+      "with a fresh Xauthority cookie. On --ready-fd it writes 'ready unix PATH' and 'x11 display N' once the\n"
+      "display is up. It ends when PROGRAM or Xvnc ends, or on SIGTERM, and removes what it made.");
+  app.footer(
+      "Exit status: PROGRAM's (128+signal when killed), 1 when Xvnc fails or dies, 0 after SIGTERM,\n"
+      "2 on bad flags.");
+  app.add_flag("-h,--help", out.help, "print this help and exit");
+  const std::string socket_expected = "a path of 1 to " + std::to_string(kMaxSocketPath) + " bytes";
+  app.add_option("--rfb-socket", o.rfb_socket, "Xvnc's RFB unix socket (mode 0600); required")
+      ->type_name("PATH")
+      ->check(cli::satisfies([](const std::string& v) { return !v.empty() && v.size() <= kMaxSocketPath; },
+                             socket_expected));
+  app.add_option("--xauthority", o.xauthority, "the Xauthority file to write (and remove at the end); required")
+      ->type_name("PATH")->check(cli::non_empty());
+  const std::string geometry_expected =
+      "WxH with each side in " + std::to_string(kMinSide) + ".." + std::to_string(kMaxSide);
+  app.add_option_function<std::string>(
+         "--geometry", [&o](const std::string& v) { parse_geometry(v, o.width, o.height); },
+         "the screen's size in pixels; required")
+      ->type_name("WxH")
+      ->check(cli::satisfies([](const std::string& v) { int w = 0, h = 0; return parse_geometry(v, w, h); },
+                             geometry_expected));
+  cli::one_of(app.add_option("--depth", o.depth, "the screen's colour depth in bits")->capture_default_str(),
+              {"16", "24"});
+  // 0..2 are the standard streams, never a pipe of the manager's.
+  app.add_option("--ready-fd", o.ready_fd, "where to write the ready lines (default: nowhere)")
+      ->type_name("N")->transform(cli::in_range(3, 1 << 20));
+  app.add_option("--xvnc", o.xvnc, "the Xvnc binary (TigerVNC)")
+      ->type_name("PATH")->capture_default_str()->check(cli::non_empty());
+  app.add_option("PROGRAM", o.program,
+                 "after '--': the program and its arguments (searched in PATH when it holds no '/')");
 }
 
 }  // namespace
 
 ParsedOptions parse_session_options(const std::vector<std::string>& args) {
   ParsedOptions out;
-  std::set<std::string> seen;
-  std::size_t i = 0;
-  for (; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    if (arg == "--") {
-      ++i;
-      break;
-    }
-    if (arg == "--help" || arg == "-h") {
-      out.help = true;
-      return out;
-    }
-    // "--flag=value" or "--flag value".
-    std::string flag = arg;
-    std::string value;
-    if (const std::size_t equals = arg.find('='); arg.rfind("--", 0) == 0 && equals != std::string::npos) {
-      flag = arg.substr(0, equals);
-      value = arg.substr(equals + 1);
-    } else if (arg.rfind("--", 0) != 0) {
-      out.error = "'" + arg + "' is not a flag (the program goes after '--')";
-      return out;
-    } else if (i + 1 < args.size()) {
-      value = args[++i];
-    } else {
-      out.error = flag + " needs a value";
-      return out;
-    }
-    if (!seen.insert(flag).second) {
-      out.error = flag + " is given twice";
-      return out;
-    }
-    if (std::string problem = take(flag, value, out.options); !problem.empty()) {
-      out.error = std::move(problem);
-      return out;
-    }
+  CLI::App app("", "rfbsim_x11_session");
+  declare_session_options(app, out);
+  out.error = cli::parse(app, args);
+  if (out.help) {
+    out.error.clear();
+    return out;
   }
-  out.options.program.assign(args.begin() + static_cast<std::ptrdiff_t>(i), args.end());
+  if (!out.error.empty()) return out;
+  // The program and its arguments are exactly what follows the first "--": anything CLI11 took as PROGRAM
+  // before it is a stray word.
+  const auto dashes = std::find(args.begin(), args.end(), "--");
+  const auto after = dashes == args.end() ? std::size_t{0} : static_cast<std::size_t>(args.end() - dashes - 1);
+  if (out.options.program.size() != after) {
+    out.error = "'" + out.options.program.front() + "' is not a flag (the program goes after '--')";
+    return out;
+  }
 
   // What every session needs.
   if (out.options.rfb_socket.empty()) {
@@ -114,13 +110,10 @@ ParsedOptions parse_session_options(const std::vector<std::string>& args) {
 }
 
 std::string session_usage() {
-  return "usage: rfbsim_x11_session --rfb-socket PATH --xauthority PATH --geometry WxH [--depth 16|24]\n"
-         "                          [--ready-fd N] [--xvnc /usr/bin/Xvnc] -- PROGRAM [ARGS...]\n"
-         "Runs PROGRAM on a private X display served by TigerVNC's Xvnc on the unix socket PATH (mode 0600),\n"
-         "with a fresh Xauthority cookie. On --ready-fd it writes 'ready unix PATH' and 'x11 display N' once the\n"
-         "display is up. It ends when PROGRAM or Xvnc ends, or on SIGTERM, and removes what it made.\n"
-         "Exit status: PROGRAM's (128+signal when killed), 1 when Xvnc fails or dies, 0 after SIGTERM,\n"
-         "2 on bad flags.\n";
+  ParsedOptions defaults;
+  CLI::App app("", "rfbsim_x11_session");
+  declare_session_options(app, defaults);
+  return app.help();
 }
 
 }  // namespace rfbsim::x11

@@ -54,7 +54,7 @@ TEST_CASE("the command line finds a session by uid or id under --data-dir folder
         "give SESSION_DIR or --data-dir with --uid or --session, not both");
   CHECK(fails({"s", "--uid", "a"}) ==
         "--uid picks a session under --data-dir folders: give --data-dir DIR (or the SESSION_DIR alone)");
-  CHECK(fails({"--data-dir", "d", "--uid"}) == "--uid needs a participant id");
+  CHECK(fails({"--data-dir", "d", "--uid"}) == "--uid needs a value");
   // The old form is as it was.
   CHECK(parse_cli({"s"}, error)->session_dir == "s");
   CHECK(fails({}) == "SESSION_DIR is missing");

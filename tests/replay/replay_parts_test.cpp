@@ -55,12 +55,12 @@ TEST_CASE("the command line takes a session folder, the video and its view, the 
   };
   CHECK(fails({}) == "SESSION_DIR is missing");
   CHECK(fails({"a", "b"}) == "expected one SESSION_DIR");
-  CHECK(fails({"s", "--video"}) == "--video needs a file name (out.mp4)");
-  CHECK(fails({"s", "--view", "side", "--video", "v.mp4"}) == "--view: expected participant or top, got 'side'");
+  CHECK(fails({"s", "--video"}) == "--video needs a value");
+  CHECK(fails({"s", "--view", "side", "--video", "v.mp4"}) == "bad value 'side' for --view (expected participant or top)");
   CHECK(fails({"s", "--view", "top"}) == "--view chooses the video's camera: it needs --video FILE");
   CHECK(fails({"s", "--check-only", "--video", "v.mp4"}) ==
         "--check-only writes no video: give --video or --check-only, not both");
-  CHECK(fails({"s", "--speed", "2"}) == "unknown option '--speed'");
+  CHECK(fails({"s", "--speed", "2"}) == "unknown argument '--speed'");
   CHECK(parse_cli({"--", "-odd-folder"}, error)->session_dir == "-odd-folder");
 }
 

@@ -74,10 +74,11 @@ TEST_CASE("the command line takes one or more data folders, an optional out fold
   CHECK_FALSE(parse_cli({"a", ""}, error).has_value());
   CHECK(error.message == "a DATA_DIR is empty");
   CHECK_FALSE(parse_cli({"data", "--out"}, error).has_value());
-  CHECK(error.message == "--out needs a folder");
+  CHECK(error.message == "--out needs a value");
   CHECK_FALSE(parse_cli({"data", "--verbose"}, error).has_value());
-  CHECK(error.message == "unknown option '--verbose'");
-  CHECK_THAT(usage_text(), Catch::Contains("sim_report DATA_DIR [DATA_DIR...] [--out DIR]"));
+  CHECK(error.message == "unknown argument '--verbose'");
+  CHECK_THAT(usage_text(), Catch::Contains("usage: sim_report [OPTIONS] [DATA_DIR...]"));
+  CHECK_THAT(usage_text(), Catch::Contains("--out DIR"));
 }
 
 TEST_CASE("the progress bar redraws one line on a terminal and prints a line per tenth in a log") {

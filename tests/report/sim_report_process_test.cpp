@@ -73,5 +73,5 @@ TEST_CASE("sim_report exits 2 on usage errors and 0 for help") {
   CHECK(sim_report(scratch, "--frobnicate " + quoted(scratch.path())) == 2);
   CHECK(sim_report(scratch, quoted(scratch.path() / "no-such-folder")) == 2);
   CHECK(sim_report(scratch, "--help") == 0);
-  CHECK_THAT(read_text(scratch.path() / "stdout.txt"), Catch::Contains("Usage: sim_report DATA_DIR"));
+  CHECK_THAT(read_text(scratch.path() / "stdout.txt"), Catch::Contains("usage: sim_report [OPTIONS] [DATA_DIR...]"));
 }

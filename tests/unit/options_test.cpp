@@ -49,7 +49,7 @@ TEST_CASE("bad arguments are named") {
   CHECK(parse_sim_options({"--port", "12x"}).error == "bad value '12x' for --port");
   CHECK(parse_sim_options({"--width", "-5"}).error == "bad value '-5' for --width");
   CHECK(parse_sim_options({"--fps", "0"}).error == "bad value '0' for --fps");
-  CHECK(parse_sim_options({"--egl", "x11"}).error == "bad value 'x11' for --egl");
+  CHECK(parse_sim_options({"--egl", "x11"}).error == "bad value 'x11' for --egl (expected auto, device or surfaceless)");
   CHECK(parse_sim_options({"--frobnicate"}).error == "unknown argument '--frobnicate'");
   CHECK(parse_sim_options({"--help"}).options.help);
 }

@@ -1,76 +1,88 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// sim_replay's command line.
+// sim_replay's command line: each option declared once with CLI11, from which parsing and --help follow.
 #include "replay_cli.hpp"
 
-#include "cli_option.hpp"
+#include "cli/command_line.hpp"
 
 namespace rfbsim::replay {
 
-using tools::is_option;
-using tools::option_value;
+namespace {
+
+// What the command line gives that ReplayOptions keeps in another form.
+struct ReplayArgs {
+  std::vector<std::string> positional;  // SESSION_DIR, once
+  std::vector<std::string> data_dirs;
+  std::string video, out_dir;
+  std::string view = "participant";
+  bool check_only = false;
+};
+
+// Declares sim_replay's arguments on `app`, bound to `options` and `given`.
+void declare_replay_cli(CLI::App& app, ReplayOptions& options, ReplayArgs& given) {
+  using cli::non_empty;
+  cli::configure(app);
+  app.description(
+      "   or: sim_replay --data-dir DIR [--data-dir DIR...] (--uid UID | --session ID) [--host HOST] [options]\n"
+      "\n"
+      "Re-runs a recorded session (a folder with session.json, trajectories.csv and events.jsonl, as\n"
+      "sim_rfb --data-dir writes it) from its scenario, seed and recorded inputs, and checks that every\n"
+      "pose in trajectories.csv comes out the same, to the last digit. With --video it also renders the\n"
+      "session as the participant saw it (or from above) into an H.264 MP4 at the recorded frame size\n"
+      "and frame rate.");
+  app.footer(
+      "Exit status: 0 the replay matches the log (and the video was written); 1 failure (no GL, no H.264\n"
+      "encoder, a write failed); 2 usage errors, unreadable session data, or a refused replay (another\n"
+      "version or build, a changed scenario or map; see --force); 3 the replay differs from the log (the\n"
+      "first differing line is printed; the video, if any, is not kept unless --force).");
+  app.add_flag("-h,--help", options.help, "print this help and exit");
+  app.add_option("SESSION_DIR", given.positional, "the recorded session's folder");
+  app.add_option("--data-dir", given.data_dirs,
+                 "look for the session under DIR (repeat it for several hosts' data folders or the\n"
+                 "shared store <store>/<host_id>/<folder>/) instead of giving its SESSION_DIR")
+      ->type_name("DIR")->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)->check(non_empty());
+  app.add_option("--uid", options.uid, "the session of participant UID (session.json's uid)")
+      ->type_name("UID")->check(non_empty());
+  app.add_option("--session", options.session, "the session folder named ID (3-p003), or the manager's session id (3)")
+      ->type_name("ID")->check(non_empty());
+  app.add_option("--host", options.host,
+                 "only sessions of HOST (manager.json's host, else the store folder's name); use it\n"
+                 "when UID or ID matches sessions of several hosts (listed in the error)")
+      ->type_name("HOST")->check(non_empty());
+  app.add_option("--video", given.video, "write the video to FILE (MP4, H.264, yuv420p; replaced if it exists)")
+      ->type_name("FILE")->check(non_empty());
+  cli::one_of(app.add_option("--view", given.view,
+                             "participant (the participant's camera and HUD) or top (the whole map\n"
+                             "from above, with the HUD)")
+                  ->capture_default_str(),
+              {"participant", "top"});
+  app.add_flag("--check-only", given.check_only, "only check the poses (the default without --video)");
+  app.add_option("--out-dir", given.out_dir,
+                 "keep the replay's own session.json, trajectories.csv and events.jsonl in DIR\n"
+                 "(a new or empty folder; default: a temporary folder, removed at the end)")
+      ->type_name("DIR")->check(non_empty());
+  app.add_flag("--force", options.force,
+               "replay even when the log was recorded by another rfbsim version or build, or\n"
+               "its scenario or map changed since (warns; the poses will likely differ)");
+  app.add_flag("-q,--quiet", options.quiet, "no progress line on stderr");
+}
+
+}  // namespace
 
 std::optional<ReplayOptions> parse_cli(const std::vector<std::string>& args, CliError& error) {
   ReplayOptions options;
-  std::vector<std::string> positional;
-  bool check_only = false;
-  bool view_given = false;
-  bool options_end = false;  // after "--" everything is a path, even "-x"
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    if (options_end || arg.empty() || arg[0] != '-' || arg == "-") {
-      positional.push_back(arg);
-    } else if (arg == "--") {
-      options_end = true;
-    } else if (arg == "--help" || arg == "-h") {
-      options.help = true;
-      return options;
-    } else if (is_option(arg, "--video")) {
-      const auto value = option_value(args, i, "--video", "a file name (out.mp4)", error.message);
-      if (!value) return std::nullopt;
-      options.video = *value;
-    } else if (is_option(arg, "--out-dir")) {
-      const auto value = option_value(args, i, "--out-dir", "a folder", error.message);
-      if (!value) return std::nullopt;
-      options.out_dir = *value;
-    } else if (is_option(arg, "--view")) {
-      const auto value = option_value(args, i, "--view", "participant or top", error.message);
-      if (!value) return std::nullopt;
-      if (*value == "participant") {
-        options.view = View::Participant;
-      } else if (*value == "top") {
-        options.view = View::Top;
-      } else {
-        error.message = "--view: expected participant or top, got '" + *value + "'";
-        return std::nullopt;
-      }
-      view_given = true;
-    } else if (is_option(arg, "--data-dir")) {
-      const auto value = option_value(args, i, "--data-dir", "a folder", error.message);
-      if (!value) return std::nullopt;
-      options.data_dirs.emplace_back(*value);
-    } else if (is_option(arg, "--uid")) {
-      const auto value = option_value(args, i, "--uid", "a participant id", error.message);
-      if (!value) return std::nullopt;
-      options.uid = *value;
-    } else if (is_option(arg, "--session")) {
-      const auto value = option_value(args, i, "--session", "a session folder's name or id", error.message);
-      if (!value) return std::nullopt;
-      options.session = *value;
-    } else if (is_option(arg, "--host")) {
-      const auto value = option_value(args, i, "--host", "a host id", error.message);
-      if (!value) return std::nullopt;
-      options.host = *value;
-    } else if (arg == "--check-only") {
-      check_only = true;
-    } else if (arg == "--force") {
-      options.force = true;
-    } else if (arg == "--quiet" || arg == "-q") {
-      options.quiet = true;
-    } else {
-      error.message = "unknown option '" + arg + "'";
-      return std::nullopt;
-    }
-  }
+  ReplayArgs given;
+  CLI::App app("", "sim_replay");
+  declare_replay_cli(app, options, given);
+  error.message = cli::parse(app, args);
+  if (!error.message.empty()) return std::nullopt;
+  if (options.help) return options;
+  const std::vector<std::string>& positional = given.positional;
+  const bool check_only = given.check_only;
+  const bool view_given = app.count("--view") > 0;
+  options.view = given.view == "top" ? View::Top : View::Participant;
+  if (!given.video.empty()) options.video = given.video;
+  if (!given.out_dir.empty()) options.out_dir = given.out_dir;
+  options.data_dirs.assign(given.data_dirs.begin(), given.data_dirs.end());
   // Either the session's folder, or where to look for it and which one.
   if (!options.data_dirs.empty()) {
     if (!positional.empty()) {
@@ -103,38 +115,11 @@ std::optional<ReplayOptions> parse_cli(const std::vector<std::string>& args, Cli
 }
 
 std::string usage_text() {
-  return "Usage: sim_replay SESSION_DIR [--video FILE] [--view participant|top] [--check-only]\n"
-         "                  [--out-dir DIR] [--force] [--quiet]\n"
-         "       sim_replay --data-dir DIR [--data-dir DIR...] (--uid UID | --session ID) [--host HOST] [options]\n"
-         "\n"
-         "Re-runs a recorded session (a folder with session.json, trajectories.csv and events.jsonl, as\n"
-         "sim_rfb --data-dir writes it) from its scenario, seed and recorded inputs, and checks that every\n"
-         "pose in trajectories.csv comes out the same, to the last digit. With --video it also renders the\n"
-         "session as the participant saw it (or from above) into an H.264 MP4 at the recorded frame size\n"
-         "and frame rate.\n"
-         "\n"
-         "Options:\n"
-         "  --data-dir DIR     look for the session under DIR (repeat it for several hosts' data folders or the\n"
-         "                     shared store <store>/<host_id>/<folder>/) instead of giving its SESSION_DIR\n"
-         "  --uid UID          the session of participant UID (session.json's uid)\n"
-         "  --session ID       the session folder named ID (3-p003), or the manager's session id (3)\n"
-         "  --host HOST        only sessions of HOST (manager.json's host, else the store folder's name); use it\n"
-         "                     when UID or ID matches sessions of several hosts (listed in the error)\n"
-         "  --video FILE       write the video to FILE (MP4, H.264, yuv420p; replaced if it exists)\n"
-         "  --view VIEW        participant (default: the participant's camera and HUD) or top (the whole map\n"
-         "                     from above, with the HUD)\n"
-         "  --check-only       only check the poses (the default without --video)\n"
-         "  --out-dir DIR      keep the replay's own session.json, trajectories.csv and events.jsonl in DIR\n"
-         "                     (a new or empty folder; default: a temporary folder, removed at the end)\n"
-         "  --force            replay even when the log was recorded by another rfbsim version or build, or\n"
-         "                     its scenario or map changed since (warns; the poses will likely differ)\n"
-         "  -q, --quiet        no progress line on stderr\n"
-         "  -h, --help         this text\n"
-         "\n"
-         "Exit status: 0 the replay matches the log (and the video was written); 1 failure (no GL, no H.264\n"
-         "encoder, a write failed); 2 usage errors, unreadable session data, or a refused replay (another\n"
-         "version or build, a changed scenario or map; see --force); 3 the replay differs from the log (the\n"
-         "first differing line is printed; the video, if any, is not kept unless --force).\n";
+  ReplayOptions options;
+  ReplayArgs given;
+  CLI::App app("", "sim_replay");
+  declare_replay_cli(app, options, given);
+  return app.help();
 }
 
 }  // namespace rfbsim::replay
