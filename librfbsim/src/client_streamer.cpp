@@ -14,6 +14,7 @@ extern "C" {
 #include <utility>
 
 #include "h264_encoder.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::detail {
 
@@ -191,7 +192,7 @@ bool ClientStreamer::use_h264() {
   try {
     encoder_ = std::make_unique<H264Encoder>(config_.width, config_.height, config_.frame_rate);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "[rfbsim.server] H.264 unavailable, staying with Tight JPEG: %s\n", e.what());
+    rfbsim::log::info("rfbsim.server", "H.264 unavailable, staying with Tight JPEG: %s", e.what());
     h264_failed_ = true;
     return false;
   }
@@ -222,7 +223,7 @@ ClientStreamer::Sent ClientStreamer::send_h264(rfbClientPtr client, TimePoint no
   } catch (const std::exception& e) {
     // The encoder is unusable after a failure: this client goes back to Tight (whose first update is
     // whole: everything is marked changed), with a context reset so the page drops its H.264 decoder.
-    std::fprintf(stderr, "[rfbsim.server] H.264 encoding failed, back to Tight JPEG: %s\n", e.what());
+    rfbsim::log::warn("rfbsim.server", "H.264 encoding failed, back to Tight JPEG: %s", e.what());
     encoder_.reset();
     h264_ = false;
     h264_failed_ = true;

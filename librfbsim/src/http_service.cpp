@@ -13,6 +13,7 @@
 
 #include "http_request.hpp"
 #include "static_files.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::detail {
 
@@ -148,7 +149,7 @@ void HttpService::serve_one(int fd) {
   }
   if (status < 0) return;
   if (parsed.status == HttpParseResult::Status::Invalid) {
-    std::fprintf(stderr, "[rfbsim.http] bad request: %s\n", parsed.error.c_str());
+    rfbsim::log::limited(rfbsim::log::Level::kInfo, "bad-http-request", "rfbsim.http", "bad request: %s", parsed.error.c_str());
   }
   respond(fd, status == 0 ? &parsed.request : nullptr, status);
 }

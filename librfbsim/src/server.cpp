@@ -34,6 +34,7 @@
 #include "origin_policy.hpp"
 #include "rfb_extension.hpp"
 #include "server_impl.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim {
 
@@ -324,7 +325,7 @@ void Server::Impl::drop_stalled_handshakes(Clock::time_point now) {
     const auto* state = static_cast<const ClientState*>(cl->clientData);
     if (cl->sock == RFB_INVALID_SOCKET || state == nullptr || cl->state == rfbClientRec::RFB_NORMAL) continue;
     if (now - state->connected < kHandshakeTimeout) continue;
-    std::fprintf(stderr, "[rfbsim.server] dropping client %d: no RFB handshake within %lld s\n", state->info.id,
+    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-dropped", "rfbsim.server", "dropping client %d: no RFB handshake within %lld s", state->info.id,
                  static_cast<long long>(std::chrono::duration_cast<std::chrono::seconds>(kHandshakeTimeout).count()));
     rfbCloseClient(cl);
   }
@@ -342,7 +343,7 @@ bool Server::Impl::may_send_update(rfbClientPtr cl, Clock::time_point now) {
   if (!state->backed_up_since) state->backed_up_since = now;
   if (now - *state->backed_up_since >= options.write_timeout) {
     // By id only: the address may be a participant's (from a PROXY line), which logs must not hold.
-    std::fprintf(stderr, "[rfbsim.server] dropping client %d: it read nothing for %lld ms\n", state->info.id,
+    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-dropped", "rfbsim.server", "dropping client %d: it read nothing for %lld ms", state->info.id,
                  static_cast<long long>(options.write_timeout.count()));
     ++backed_up_drops;
     rfbCloseClient(cl);

@@ -21,6 +21,7 @@
 #include "proxy_header.hpp"
 #include "server_impl.hpp"
 #include "static_files.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim {
 
@@ -56,7 +57,7 @@ void Server::Impl::accept_new(Clock::time_point now) {
       return;  // EAGAIN: no more for now
     }
     if (accept_refusals > 0) {
-      std::fprintf(stderr, "[rfbsim.server] accepting connections again after %llu refused tries\n",
+      rfbsim::log::warn("rfbsim.server", "accepting connections again after %llu refused tries",
                    static_cast<unsigned long long>(accept_refusals));
       accept_refusals = 0;
     }
@@ -67,7 +68,7 @@ void Server::Impl::accept_new(Clock::time_point now) {
 void Server::Impl::pause_accepting(Clock::time_point now, int error) {
   accept_paused_until = now + kAcceptPause;
   if (accept_refusals++ == 0) {
-    std::fprintf(stderr, "[rfbsim.server] cannot accept connections: %s; trying again every %lld ms\n",
+    rfbsim::log::warn("rfbsim.server", "cannot accept connections: %s; trying again every %lld ms",
                  std::strerror(error), static_cast<long long>(kAcceptPause.count()));
   }
 }
@@ -77,9 +78,9 @@ void Server::Impl::add_pending(int fd, Clock::time_point now) {
   // so only a flood reaches the cap, and then the newest connections are the likeliest to be real.
   if (static_cast<int>(pending.size()) >= options.max_pending_connections) {
     if (pending_evicted++ == 0) {
-      std::fprintf(stderr,
-                   "[rfbsim.server] more than %d connections waiting to be classified: closing the oldest "
-                   "(logged once)\n",
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "intake-backlog", "rfbsim.server",
+                   "more than %d connections waiting to be classified: closing the oldest "
+                   "(logged once)",
                    options.max_pending_connections);
     }
     ::close(pending.front().fd);  // its only descriptor: closing also takes it out of the epoll set
@@ -89,7 +90,7 @@ void Server::Impl::add_pending(int fd, Clock::time_point now) {
   event.events = EPOLLIN | EPOLLRDHUP | EPOLLET;
   event.data.fd = fd;
   if (::epoll_ctl(pending_epoll, EPOLL_CTL_ADD, fd, &event) != 0) {
-    std::fprintf(stderr, "[rfbsim.server] refusing a connection: cannot watch it (%s)\n", std::strerror(errno));
+    rfbsim::log::warn("rfbsim.server", "refusing a connection: cannot watch it (%s)", std::strerror(errno));
     ::close(fd);
     return;
   }
@@ -170,11 +171,11 @@ bool Server::Impl::take_proxy_header(PendingConnection& connection, std::string_
   switch (header.status) {
     case detail::ProxyHeader::Status::Incomplete:
       if (now - connection.accepted < options.read_timeout) return true;
-      std::fprintf(stderr, "[rfbsim.server] closing a connection: no PROXY line within %lld ms\n",
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "proxy-line", "rfbsim.server", "closing a connection: no PROXY line within %lld ms",
                    static_cast<long long>(options.read_timeout.count()));
       return false;
     case detail::ProxyHeader::Status::Invalid:
-      std::fprintf(stderr, "[rfbsim.server] closing a connection: it did not begin with a PROXY line\n");
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "proxy-line", "rfbsim.server", "closing a connection: it did not begin with a PROXY line");
       return false;
     case detail::ProxyHeader::Status::Valid: break;
   }
@@ -219,14 +220,14 @@ void Server::Impl::log_refused_origin(const std::string& origin) {
   if (logged_origins.size() >= kMaxLoggedOrigins) {
     if (logged_origins.size() == kMaxLoggedOrigins) {
       logged_origins.insert("");  // marks that the log said so once
-      std::fprintf(stderr, "[rfbsim.server] more refused origins than the log names; they are only counted\n");
+      rfbsim::log::warn("rfbsim.server", "more refused origins than the log names; they are only counted");
     }
     return;
   }
   logged_origins.insert(origin);
-  std::fprintf(stderr,
-               "[rfbsim.server] refused a WebSocket from a page at '%.*s': neither this server's page, nor "
-               "loopback, nor allowed by --allow-origin (logged once per origin)\n",
+  rfbsim::log::warn("rfbsim.server",
+               "refused a WebSocket from a page at '%.*s': neither this server's page, nor "
+               "loopback, nor allowed by --allow-origin (logged once per origin)",
                static_cast<int>(std::min(origin.size(), kMaxLoggedOriginBytes)), origin.c_str());
 }
 
@@ -236,8 +237,8 @@ void Server::Impl::adopt_rfb(const PendingConnection& connection, bool head_chec
   // for every silent connection (so a flood of idle connections costs nothing once the slots are taken).
   if (clients.load() >= options.max_clients) {
     if (full_refusals++ == 0) {
-      std::fprintf(stderr, "[rfbsim.server] refusing clients: %d of %d already connected (logged once until "
-                   "one is accepted)\n", clients.load(), options.max_clients);
+      rfbsim::log::info("rfbsim.server", "refusing clients: %d of %d already connected (logged once until "
+                   "one is accepted)", clients.load(), options.max_clients);
     }
     ::close(fd);
     return;
@@ -250,7 +251,7 @@ void Server::Impl::adopt_rfb(const PendingConnection& connection, bool head_chec
   // the socket itself; our duplicate keeps the watchdog's descriptor valid meanwhile.
   const int guard = ::fcntl(fd, F_DUPFD_CLOEXEC, 0);
   if (guard < 0) {
-    std::fprintf(stderr, "[rfbsim.server] refusing a client: out of file descriptors\n");
+    rfbsim::log::limited(rfbsim::log::Level::kWarn, "out-of-fds", "rfbsim.server", "refusing a client: out of file descriptors");
     ::close(fd);
     return;
   }

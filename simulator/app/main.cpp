@@ -39,6 +39,7 @@
 #include "rfbsim/server.hpp"
 #include "scenario/scenario.hpp"
 #include "world/fixed_step_clock.hpp"
+#include "rfbsim/log.hpp"
 
 namespace {
 
@@ -138,7 +139,7 @@ class StreamReporter {
     const std::string error = write_line(fd_, line);
     if (error.empty()) return;
     failed_ = true;
-    std::fprintf(stderr, "[sim_rfb] cannot report the stream to the parent: %s; no more stream lines\n",
+    rfbsim::log::warn("sim_rfb", "cannot report the stream to the parent: %s; no more stream lines",
                  error.c_str());
   }
 
@@ -221,7 +222,7 @@ rfbsim::sim::SessionSetup setup_of(const rfbsim::sim::SimOptions& options) {
 // The robot's state changes of the last tick, one log line each ("[robot] 12.35 s moving: ...").
 void log_robot_events(const rfbsim::sim::World& world, double dt) {
   for (const rfbsim::sim::RobotEvent& event : world.robot_events) {
-    std::fprintf(stderr, "[robot] %.2f s %s: %s\n", static_cast<double>(event.tick) * dt,
+    rfbsim::log::info("robot", "%.2f s %s: %s", static_cast<double>(event.tick) * dt,
                  rfbsim::sim::robot_state_name(event.state), event.detail.c_str());
   }
 }
@@ -239,7 +240,7 @@ rfbsim::sim::SessionWriterOptions writer_options_from_environment() {
     throw std::runtime_error(std::string("RFBSIM_TEST_FAIL_WRITES_AFTER: '") + limit + "' is not a byte count");
   }
   options.faults.fail_after_bytes = bytes;
-  std::fprintf(stderr, "[sim_rfb] test fault: session data writes fail after %llu bytes\n", bytes);
+  rfbsim::log::info("sim_rfb", "test fault: session data writes fail after %llu bytes", bytes);
   return options;
 }
 
@@ -252,7 +253,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   sim::PreparedSession prepared = sim::prepare_session(setup_of(options));
   sim::Simulation& simulation = *prepared.simulation;
   if (!options.scenario.empty()) {
-    std::fprintf(stderr, "[sim_rfb] scenario %s (%s), seed %llu, %zu people\n", prepared.info.scenario.c_str(),
+    rfbsim::log::info("sim_rfb", "scenario %s (%s), seed %llu, %zu people", prepared.info.scenario.c_str(),
                  prepared.info.scenario_file.c_str(), static_cast<unsigned long long>(prepared.info.seed),
                  simulation.world().people.size());
   }
@@ -260,8 +261,8 @@ int run(const rfbsim::sim::SimOptions& options) {
   const sim::RobotStack* robot_stack = simulation.robot_stack();
   if (robot_stack && robot_stack->control() == sim::RobotControl::kExternal && !options.rosbridge_port &&
       options.rosbridge_connect.empty()) {
-    std::fprintf(stderr, "[ros] warning: the robot is under external control but no rosbridge is configured "
-                         "(--rosbridge-port or --rosbridge-connect): nothing can drive it, and it will stand still\n");
+    rfbsim::log::warn("ros", "warning: the robot is under external control but no rosbridge is configured "
+                         "(--rosbridge-port or --rosbridge-connect): nothing can drive it, and it will stand still");
   }
   // Session data from the first tick on, when asked for.
   std::unique_ptr<sim::SessionWriter> writer;
@@ -294,7 +295,7 @@ int run(const rfbsim::sim::SimOptions& options) {
     const std::string notice = study.take_data_notice();
     if (notice.empty() || !options.ready_fd) return;
     const std::string error = write_line(*options.ready_fd, notice);
-    if (!error.empty()) std::fprintf(stderr, "[sim_rfb] cannot report incomplete data to the parent: %s\n", error.c_str());
+    if (!error.empty()) rfbsim::log::warn("sim_rfb", "cannot report incomplete data to the parent: %s", error.c_str());
   };
   const std::string address_key = sim::address_hash_key();
 
@@ -324,12 +325,12 @@ int run(const rfbsim::sim::SimOptions& options) {
   ClientChanges client_changes;
   // The log names the participant's address only hashed, as the session data does.
   server_options.on_connect = [&client_changes, &address_key](const rfbsim::ClientInfo& c) {
-    std::fprintf(stderr, "[sim_rfb] client %d connected, address %s (%s)\n", c.id,
+    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-connected", "sim_rfb", "client %d connected, address %s (%s)", c.id,
                  sim::hash_address(address_key, c.address).c_str(), c.websocket ? "websocket" : "rfb");
     client_changes.push(true, c);
   };
   server_options.on_disconnect = [&client_changes](const rfbsim::ClientInfo& c) {
-    std::fprintf(stderr, "[sim_rfb] client %d disconnected\n", c.id);
+    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-disconnected", "sim_rfb", "client %d disconnected", c.id);
     client_changes.push(false, c);
   };
   rfbsim::Server server(std::move(server_options));
@@ -339,8 +340,8 @@ int run(const rfbsim::sim::SimOptions& options) {
   gl_options.height = options.height;
   gl_options.platform = options.egl_platform;
   rfbsim::OffscreenGL gl(gl_options);
-  std::fprintf(stderr, "[sim_rfb] rendering with %s\n", gl.renderer().c_str());
-  std::fprintf(stderr, "[sim_rfb] picture encoding %s, %d frames per second while watched\n", options.codec.c_str(),
+  rfbsim::log::info("sim_rfb", "rendering with %s", gl.renderer().c_str());
+  rfbsim::log::info("sim_rfb", "picture encoding %s, %d frames per second while watched", options.codec.c_str(),
                options.fps);
 
   sim::FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / options.tick_hz));
@@ -417,7 +418,7 @@ int run(const rfbsim::sim::SimOptions& options) {
       // events.jsonl): those may well go on while the larger bag cannot.
       if (const auto failure = ros_link->bag_failure(); failure && !bag_failure_told) {
         bag_failure_told = true;
-        std::fprintf(stderr, "[ros] session.mcap stopped growing: %s (the session and its other files go on)\n",
+        rfbsim::log::info("ros", "session.mcap stopped growing: %s (the session and its other files go on)",
                      failure->c_str());
       }
     }
@@ -430,12 +431,12 @@ int run(const rfbsim::sim::SimOptions& options) {
     if (!outcome_reported && study.outcome() != sim::TaskOutcome::None) {
       outcome_reported = true;
       const char* outcome = sim::task_outcome_name(study.outcome());
-      std::fprintf(stderr, "[task] %.2f s outcome %s\n", simulation.world().time, outcome);
+      rfbsim::log::info("task", "%.2f s outcome %s", simulation.world().time, outcome);
       if (options.ready_fd) {
         const auto end = study.outcome() == sim::TaskOutcome::Completed ? rfbsim::contract::TaskEnd::kCompleted
                                                                         : rfbsim::contract::TaskEnd::kTimeout;
         const std::string error = write_line(*options.ready_fd, rfbsim::contract::outcome_line(end));
-        if (!error.empty()) std::fprintf(stderr, "[sim_rfb] cannot report the outcome to the parent: %s\n", error.c_str());
+        if (!error.empty()) rfbsim::log::warn("sim_rfb", "cannot report the outcome to the parent: %s", error.c_str());
       }
     }
     if (study.over()) {
@@ -468,7 +469,8 @@ int run(const rfbsim::sim::SimOptions& options) {
   if (ros_link) ros_link->finish();  // after the end's events, which the bag records too
   report_data_notice();  // the end's own writes may have been the ones that failed
   if (options.ready_fd) ::close(*options.ready_fd);
-  std::fprintf(stderr, "[sim_rfb] stopping after %llu ticks, %llu frames (%s)\n",
+  rfbsim::log::flush_suppressed();  // what the rate limit held back is counted before the last line
+  rfbsim::log::info("sim_rfb", "stopping after %llu ticks, %llu frames (%s)",
                static_cast<unsigned long long>(simulation.world().tick),
                static_cast<unsigned long long>(frames_rendered), end_reason.c_str());
   return 0;
@@ -487,6 +489,8 @@ int main(int argc, char** argv) {
     std::fputs(rfbsim::sim::sim_usage().c_str(), stdout);
     return 0;
   }
+  rfbsim::log::Level log_level = rfbsim::log::Level::kInfo;
+  if (rfbsim::log::parse_level(parsed.options.log_level, log_level)) rfbsim::log::set_level(log_level);
   install_signal_handlers();
   try {
     return run(parsed.options);

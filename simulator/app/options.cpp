@@ -97,6 +97,7 @@ void declare_sim_options(CLI::App& app, SimOptions& o) {
   cli::one_of(app.add_option("--egl", o.egl_platform, "EGL platform (auto: GPU device, else Mesa surfaceless)")
                   ->capture_default_str(),
               {"auto", "device", "surfaceless"});
+  cli::add_log_level(app, o.log_level);
   app.add_flag("--debug-overlay", o.debug_overlay,
                "draw the robot's global path, local trajectory, goal, pose estimate and social\n"
                "cost on the floor (for developers; participants should not see it)");

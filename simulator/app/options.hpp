@@ -29,6 +29,7 @@ struct SimOptions {
   int max_clients = 4;
   std::string web_root;             ///< empty = the built or installed page
   std::string egl_platform = "auto";
+  std::string log_level = "info";   ///< error, warn, info or debug (rfbsim/log.hpp)
   bool debug_overlay = false;       ///< draw the robot's path, trajectory, goal and social cost (for developers)
   /// Serve RFB only (raw and over WebSocket): no page, no /status.json, no web root looked for.
   bool rfb_only = false;

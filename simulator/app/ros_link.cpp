@@ -18,6 +18,7 @@
 #include "ros/msgs/ros_json.hpp"
 #include "ros/msgs/ros_schemas.hpp"
 #include "ros/msgs/ros_topics.hpp"
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::sim {
 
@@ -150,7 +151,7 @@ std::vector<RobotCommand> RosLink::take_commands() {
 void RosLink::warn_ignored(const RobotCommand& command, const std::string& why) {
   if (!impl_->hub || !impl_->warned.insert(command.connection).second) return;
   impl_->hub->status(command.connection, "warning", why);
-  std::fprintf(stderr, "[ros] /cmd_vel ignored: %s\n", why.c_str());
+  rfbsim::log::limited(rfbsim::log::Level::kWarn, "cmd-vel-ignored", "ros", "/cmd_vel ignored: %s", why.c_str());
 }
 
 void RosLink::flush_if_due() {
@@ -165,7 +166,7 @@ void RosLink::finish() {
   if (impl_->bag) {
     impl_->bag->finish();
     if (const auto failure = impl_->bag->failure()) {
-      std::fprintf(stderr, "[ros] session.mcap is incomplete: %s\n", failure->c_str());
+      rfbsim::log::info("ros", "session.mcap is incomplete: %s", failure->c_str());
     }
   }
   impl_->client.reset();

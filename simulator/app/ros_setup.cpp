@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // sim_rfb's ROS side from its command line.
 #include "app/ros_setup.hpp"
+#include "rfbsim/log.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -23,7 +24,7 @@ std::string read_token_file(const std::string& path) {
   // It authenticates this study's robot to the lab's ROS.
   using std::filesystem::perms;
   if ((status.permissions() & (perms::group_read | perms::others_read)) != perms::none) {
-    std::fprintf(stderr, "[ros] warning: %s can be read by other users; chmod 600 it\n", path.c_str());
+    rfbsim::log::warn("ros", "warning: %s can be read by other users; chmod 600 it", path.c_str());
   }
   std::ifstream file(path, std::ios::binary);
   if (!file) throw std::runtime_error(what + std::strerror(errno));
@@ -52,8 +53,8 @@ bool room_for_bag(const std::filesystem::path& dir) {
   std::error_code ec;
   const std::filesystem::space_info space = std::filesystem::space(dir, ec);
   if (ec || space.available >= kBagMinFreeBytes) return true;  // unknown: the writer thread checks each chunk
-  std::fprintf(stderr, "[ros] %s has %ju KiB free, under the bag's 64 MiB floor: no session.mcap; the session's "
-                       "other files keep the space\n", dir.c_str(), static_cast<std::uintmax_t>(space.available >> 10));
+  rfbsim::log::info("ros", "%s has %ju KiB free, under the bag's 64 MiB floor: no session.mcap; the session's "
+                       "other files keep the space", dir.c_str(), static_cast<std::uintmax_t>(space.available >> 10));
   return false;
 }
 
@@ -83,11 +84,11 @@ std::unique_ptr<RosLink> open_ros_link(const SimOptions& options) {
   ros.tick_hz = options.tick_hz;
   auto link = std::make_unique<RosLink>(std::move(ros));
   if (const auto port = link->server_port()) {
-    std::fprintf(stderr, "[ros] rosbridge v2 server on ws://%s:%d/ (unauthenticated: keep it on loopback)\n",
+    rfbsim::log::info("ros", "rosbridge v2 server on ws://%s:%d/ (unauthenticated: keep it on loopback)",
                  url_host(options.rosbridge_bind).c_str(), *port);
   }
   if (!options.rosbridge_connect.empty()) {
-    std::fprintf(stderr, "[ros] rosbridge client dialling %s\n", options.rosbridge_connect.c_str());
+    rfbsim::log::info("ros", "rosbridge client dialling %s", options.rosbridge_connect.c_str());
   }
   return link;
 }

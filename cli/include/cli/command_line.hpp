@@ -142,6 +142,13 @@ inline std::string option_named_in(CLI::App& app, const std::string& message, co
 
 }  // namespace detail
 
+/// --log-level, bound to `level` (its initial value is the default): the names of rfbsim/log.hpp's levels,
+/// which the program hands to rfbsim::log::parse_level once parsing is done.
+inline CLI::Option* add_log_level(CLI::App& app, std::string& level) {
+  return one_of(app.add_option("--log-level", level, "the log's level")->type_name("L")->capture_default_str(),
+                {"error", "warn", "info", "debug"});
+}
+
 /// Parses `args` (argv without the program name) into the variables `app`'s options are bound to. Returns "" on
 /// success, else one line naming the first bad argument. Never throws, never exits, prints nothing.
 inline std::string parse(CLI::App& app, const std::vector<std::string>& args) noexcept {
