@@ -40,8 +40,12 @@
 #include "scenario/scenario.hpp"
 #include "world/fixed_step_clock.hpp"
 #include "rfbsim/log.hpp"
+#include "app/parent_pipe.hpp"
 
 namespace {
+
+using rfbsim::sim::check_ready_fd;
+using rfbsim::sim::write_line;
 
 std::atomic<bool> g_stop{false};
 
@@ -59,32 +63,6 @@ void install_signal_handlers() {
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);
   sigaction(SIGPIPE, &ignore, nullptr);
-}
-
-// --ready-fd must name a descriptor our parent opened for writing. Checked before we open anything:
-// were it closed, the number could later be reused by one of our own sockets, and the ready line would
-// go there. Throws std::runtime_error naming the problem.
-void check_ready_fd(int fd) {
-  const int flags = ::fcntl(fd, F_GETFL);
-  if (flags < 0) {
-    throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": not an open file descriptor (" +
-                             std::strerror(errno) + ")");
-  }
-  if ((flags & O_ACCMODE) == O_RDONLY) {
-    throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": open for reading only");
-  }
-}
-
-// Writes one whole line to the parent's pipe. Returns the error in words, or "" when it was written.
-std::string write_line(int fd, const std::string& line) {
-  std::size_t written = 0;
-  while (written < line.size()) {
-    const auto n = ::write(fd, line.data() + written, line.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return n < 0 ? std::strerror(errno) : "nothing written";
-    written += static_cast<std::size_t>(n);
-  }
-  return "";
 }
 
 // Tells the parent that the port is open: one line "ready <port>\n" on `fd` ("ready unix <path>\n" when
