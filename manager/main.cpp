@@ -17,19 +17,19 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "cluster/agent_check.hpp"
-#include "config/config.hpp"
-#include "http/frontend.hpp"
-#include "admission/link_signature.hpp"
 #include "admin/metrics.hpp"
+#include "admission/link_signature.hpp"
+#include "admission/start_request.hpp"
+#include "admission/tokens.hpp"
+#include "cluster/agent_check.hpp"
 #include "cluster/registry_client.hpp"
 #include "cluster/registry_server.hpp"
-#include "sessions/session_index.hpp"
-#include "admission/start_request.hpp"
-#include "sessions/supervisor.hpp"
-#include "admission/tokens.hpp"
 #include "cluster/uid_registry.hpp"
+#include "config/config.hpp"
+#include "http/frontend.hpp"
 #include "rfbsim/log.hpp"
+#include "sessions/session_index.hpp"
+#include "sessions/supervisor.hpp"
 
 extern char** environ;
 
@@ -140,8 +140,10 @@ void learn_scenarios(ManagerConfig& config) {
   config.scenario_facts = manager::load_scenario_facts(config.scenarios, scenario_search_dirs(), error, missing);
   if (!error.empty()) throw std::runtime_error(error);
   for (const std::string& entry : missing) {
-    rfbsim::log::warn("manager", "warning: scenario %s: no file found where sim_rfb looks by name; its links' spawn "
-                 "names are left to sim_rfb and max_duration_s is not fitted to its task", entry.c_str());
+    rfbsim::log::warn("manager",
+                      "warning: scenario %s: no file found where sim_rfb looks by name; its links' spawn "
+                      "names are left to sim_rfb and max_duration_s is not fitted to its task",
+                      entry.c_str());
   }
   const std::string warning = manager::fit_max_duration(config);
   if (!warning.empty()) rfbsim::log::warn("manager", "warning: %s", warning.c_str());
@@ -199,22 +201,23 @@ int run(ManagerConfig config) {
     registry_client =
         std::make_unique<manager::RegistryClient>(io, config.cluster_peers, config.host_id, key, *registry_server);
     rfbsim::log::info("manager", "uid registry on %s:%d, host %s of %zu", registry_address.c_str(),
-                 registry_server->port(), config.host_id.c_str(), config.cluster_peers.size());
+                      registry_server->port(), config.host_id.c_str(), config.cluster_peers.size());
     if (config.cluster_peers.size() % 2 == 0) {
       rfbsim::log::warn("manager",
-                   "warning: %zu cluster peers: a majority is %zu of them, so %zu down stop every new uid, "
-                   "as with %zu peers; an odd number is better (docs/architecture.md, \"uid registry\")",
-                   config.cluster_peers.size(), config.cluster_peers.size() / 2 + 1, config.cluster_peers.size() / 2,
-                   config.cluster_peers.size() - 1);
+                        "warning: %zu cluster peers: a majority is %zu of them, so %zu down stop every new uid, "
+                        "as with %zu peers; an odd number is better (docs/architecture.md, \"uid registry\")",
+                        config.cluster_peers.size(), config.cluster_peers.size() / 2 + 1,
+                        config.cluster_peers.size() / 2, config.cluster_peers.size() - 1);
     }
     // An acceptor that forgot what it promised or accepted can let a second home be decided: a host rebuilt
     // with an empty data folder must join under a new id (docs/architecture.md, "uid registry").
     if (index.registry_table_created()) {
-      rfbsim::log::warn("manager",
-                   "WARNING: this host's uid registry records are new (sessions.db or its uid_acceptors "
-                   "table was just created). Fine on a cluster's first start. If this host ran before and lost its "
-                   "sessions.db, stop it: it must rejoin under a new host_id, with every host restarted on the new "
-                   "cluster_peers list (docs/architecture.md, \"uid registry\")");
+      rfbsim::log::warn(
+          "manager",
+          "WARNING: this host's uid registry records are new (sessions.db or its uid_acceptors "
+          "table was just created). Fine on a cluster's first start. If this host ran before and lost its "
+          "sessions.db, stop it: it must rejoin under a new host_id, with every host restarted on the new "
+          "cluster_peers list (docs/architecture.md, \"uid registry\")");
     }
   }
   const auto frontend = manager::make_frontend(io, config, supervisor, metrics, web_root, registry_client.get());
@@ -234,9 +237,9 @@ int run(ManagerConfig config) {
   // over) that participant's session. Fine on loopback; on a public address it should be a choice.
   if (config.link_secret.empty() && config.listen_address.rfind("127.", 0) != 0) {
     rfbsim::log::warn("manager",
-                 "warning: links are unsigned and the port listens on %s: anyone who knows a uid can start "
-                 "or take over its session; set link_secret (docs/security.md)",
-                 config.listen_address.c_str());
+                      "warning: links are unsigned and the port listens on %s: anyone who knows a uid can start "
+                      "or take over its session; set link_secret (docs/security.md)",
+                      config.listen_address.c_str());
   }
 
   // SIGINT / SIGTERM: stop taking connections, end every session, then leave.
@@ -260,10 +263,10 @@ int run(ManagerConfig config) {
   if (!config.scenarios.empty()) example += "&scenario=" + manager::scenario_names(config.scenarios).front();
   if (!config.link_secret.empty()) example = manager::sign_query(example, config.link_secret);
   rfbsim::log::info("manager", "sessions: %s (%s), at most %d, %lld s each, idle timeout %lld s; data in %s",
-               (config.session_kind == manager::SessionKind::kX11 ? config.session_command : program).c_str(),
-               manager::session_kind_name(config.session_kind), config.max_sessions,
-               static_cast<long long>(config.max_duration.count()),
-               static_cast<long long>(config.idle_timeout.count()), config.data_dir.c_str());
+                    (config.session_kind == manager::SessionKind::kX11 ? config.session_command : program).c_str(),
+                    manager::session_kind_name(config.session_kind), config.max_sessions,
+                    static_cast<long long>(config.max_duration.count()),
+                    static_cast<long long>(config.idle_timeout.count()), config.data_dir.c_str());
   std::printf("sim_manager ready: %s/\nparticipant link: %s/start?%s\n", base.c_str(), base.c_str(), example.c_str());
   std::fflush(stdout);
   // Handlers catch what they can; anything that still escapes is logged and the loop goes on, since every

@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "http_request.hpp"
-#include "static_files.hpp"
 #include "rfbsim/log.hpp"
+#include "static_files.hpp"
 
 namespace rfbsim::detail {
 
@@ -149,7 +149,8 @@ void HttpService::serve_one(int fd) {
   }
   if (status < 0) return;
   if (parsed.status == HttpParseResult::Status::Invalid) {
-    rfbsim::log::limited(rfbsim::log::Level::kInfo, "bad-http-request", "rfbsim.http", "bad request: %s", parsed.error.c_str());
+    rfbsim::log::limited(rfbsim::log::Level::kInfo, "bad-http-request", "rfbsim.http", "bad request: %s",
+                         parsed.error.c_str());
   }
   respond(fd, status == 0 ? &parsed.request : nullptr, status);
 }

@@ -36,7 +36,8 @@ ClientState* state_of(rfbClientPtr cl) { return static_cast<ClientState*>(cl->cl
 // A peer's bad bytes close that one connection and nothing else; by id only, as addresses stay out of logs.
 void drop(rfbClientPtr cl, const char* why) {
   const ClientState* state = state_of(cl);
-  rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-dropped", "rfbsim.server", "dropping client %d: %s", state != nullptr ? state->info.id : 0, why);
+  rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-dropped", "rfbsim.server", "dropping client %d: %s",
+                       state != nullptr ? state->info.id : 0, why);
   rfbCloseClient(cl);
 }
 

@@ -7,9 +7,9 @@
 // encoded while it is being written (no tearing), and the simulation thread only ever touches the mailbox.
 #include "rfbsim/server.hpp"
 
+#include <linux/sockios.h>
 #include <poll.h>
 #include <rfb/rfb.h>
-#include <linux/sockios.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
 #include <sys/ioctl.h>
@@ -33,8 +33,8 @@
 #include "client_state.hpp"
 #include "origin_policy.hpp"
 #include "rfb_extension.hpp"
-#include "server_impl.hpp"
 #include "rfbsim/log.hpp"
+#include "server_impl.hpp"
 
 namespace rfbsim {
 
@@ -325,8 +325,10 @@ void Server::Impl::drop_stalled_handshakes(Clock::time_point now) {
     const auto* state = static_cast<const ClientState*>(cl->clientData);
     if (cl->sock == RFB_INVALID_SOCKET || state == nullptr || cl->state == rfbClientRec::RFB_NORMAL) continue;
     if (now - state->connected < kHandshakeTimeout) continue;
-    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-dropped", "rfbsim.server", "dropping client %d: no RFB handshake within %lld s", state->info.id,
-                 static_cast<long long>(std::chrono::duration_cast<std::chrono::seconds>(kHandshakeTimeout).count()));
+    rfbsim::log::limited(
+        rfbsim::log::Level::kInfo, "client-dropped", "rfbsim.server",
+        "dropping client %d: no RFB handshake within %lld s", state->info.id,
+        static_cast<long long>(std::chrono::duration_cast<std::chrono::seconds>(kHandshakeTimeout).count()));
     rfbCloseClient(cl);
   }
 }
@@ -343,8 +345,9 @@ bool Server::Impl::may_send_update(rfbClientPtr cl, Clock::time_point now) {
   if (!state->backed_up_since) state->backed_up_since = now;
   if (now - *state->backed_up_since >= options.write_timeout) {
     // By id only: the address may be a participant's (from a PROXY line), which logs must not hold.
-    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-dropped", "rfbsim.server", "dropping client %d: it read nothing for %lld ms", state->info.id,
-                 static_cast<long long>(options.write_timeout.count()));
+    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-dropped", "rfbsim.server",
+                         "dropping client %d: it read nothing for %lld ms", state->info.id,
+                         static_cast<long long>(options.write_timeout.count()));
     ++backed_up_drops;
     rfbCloseClient(cl);
     return false;

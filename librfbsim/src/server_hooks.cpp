@@ -13,8 +13,8 @@
 #include <utility>
 
 #include "client_state.hpp"
-#include "server_impl.hpp"
 #include "rfbsim/log.hpp"
+#include "server_impl.hpp"
 
 namespace rfbsim {
 
@@ -46,12 +46,14 @@ rfbNewClientAction Server::Impl::on_new_client(rfbClientPtr cl) {
   // for raw RFB): its Origin was never checked, so a browser-facing port turns it away. A real browser's
   // head comes with the connection's first packet; noVNC simply reconnects.
   if (cl->wsctx != nullptr && !self.adopting_head_checked && self.checks_origins()) {
-    rfbsim::log::limited(rfbsim::log::Level::kWarn, "late-origin", "rfbsim.server", "refusing a WebSocket whose request came too late to check its Origin");
+    rfbsim::log::limited(rfbsim::log::Level::kWarn, "late-origin", "rfbsim.server",
+                         "refusing a WebSocket whose request came too late to check its Origin");
     return RFB_CLIENT_REFUSE;
   }
   if (self.clients.load() >= self.options.max_clients) {
-    rfbsim::log::limited(rfbsim::log::Level::kInfo, "clients-full", "rfbsim.server", "refusing a client: %d of %d already connected", self.clients.load(),
-                 self.options.max_clients);
+    rfbsim::log::limited(rfbsim::log::Level::kInfo, "clients-full", "rfbsim.server",
+                         "refusing a client: %d of %d already connected", self.clients.load(),
+                         self.options.max_clients);
     return RFB_CLIENT_REFUSE;
   }
   auto* state = new ClientState(self.streamer_config);

@@ -19,9 +19,9 @@
 #include "http_request.hpp"
 #include "origin_policy.hpp"
 #include "proxy_header.hpp"
+#include "rfbsim/log.hpp"
 #include "server_impl.hpp"
 #include "static_files.hpp"
-#include "rfbsim/log.hpp"
 
 namespace rfbsim {
 
@@ -58,7 +58,7 @@ void Server::Impl::accept_new(Clock::time_point now) {
     }
     if (accept_refusals > 0) {
       rfbsim::log::warn("rfbsim.server", "accepting connections again after %llu refused tries",
-                   static_cast<unsigned long long>(accept_refusals));
+                        static_cast<unsigned long long>(accept_refusals));
       accept_refusals = 0;
     }
     add_pending(fd, now);
@@ -69,7 +69,7 @@ void Server::Impl::pause_accepting(Clock::time_point now, int error) {
   accept_paused_until = now + kAcceptPause;
   if (accept_refusals++ == 0) {
     rfbsim::log::warn("rfbsim.server", "cannot accept connections: %s; trying again every %lld ms",
-                 std::strerror(error), static_cast<long long>(kAcceptPause.count()));
+                      std::strerror(error), static_cast<long long>(kAcceptPause.count()));
   }
 }
 
@@ -79,9 +79,9 @@ void Server::Impl::add_pending(int fd, Clock::time_point now) {
   if (static_cast<int>(pending.size()) >= options.max_pending_connections) {
     if (pending_evicted++ == 0) {
       rfbsim::log::limited(rfbsim::log::Level::kWarn, "intake-backlog", "rfbsim.server",
-                   "more than %d connections waiting to be classified: closing the oldest "
-                   "(logged once)",
-                   options.max_pending_connections);
+                           "more than %d connections waiting to be classified: closing the oldest "
+                           "(logged once)",
+                           options.max_pending_connections);
     }
     ::close(pending.front().fd);  // its only descriptor: closing also takes it out of the epoll set
     pending.erase(pending.begin());
@@ -171,11 +171,13 @@ bool Server::Impl::take_proxy_header(PendingConnection& connection, std::string_
   switch (header.status) {
     case detail::ProxyHeader::Status::Incomplete:
       if (now - connection.accepted < options.read_timeout) return true;
-      rfbsim::log::limited(rfbsim::log::Level::kWarn, "proxy-line", "rfbsim.server", "closing a connection: no PROXY line within %lld ms",
-                   static_cast<long long>(options.read_timeout.count()));
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "proxy-line", "rfbsim.server",
+                           "closing a connection: no PROXY line within %lld ms",
+                           static_cast<long long>(options.read_timeout.count()));
       return false;
     case detail::ProxyHeader::Status::Invalid:
-      rfbsim::log::limited(rfbsim::log::Level::kWarn, "proxy-line", "rfbsim.server", "closing a connection: it did not begin with a PROXY line");
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "proxy-line", "rfbsim.server",
+                           "closing a connection: it did not begin with a PROXY line");
       return false;
     case detail::ProxyHeader::Status::Valid: break;
   }
@@ -226,9 +228,9 @@ void Server::Impl::log_refused_origin(const std::string& origin) {
   }
   logged_origins.insert(origin);
   rfbsim::log::warn("rfbsim.server",
-               "refused a WebSocket from a page at '%.*s': neither this server's page, nor "
-               "loopback, nor allowed by --allow-origin (logged once per origin)",
-               static_cast<int>(std::min(origin.size(), kMaxLoggedOriginBytes)), origin.c_str());
+                    "refused a WebSocket from a page at '%.*s': neither this server's page, nor "
+                    "loopback, nor allowed by --allow-origin (logged once per origin)",
+                    static_cast<int>(std::min(origin.size(), kMaxLoggedOriginBytes)), origin.c_str());
 }
 
 void Server::Impl::adopt_rfb(const PendingConnection& connection, bool head_checked) {
@@ -237,8 +239,10 @@ void Server::Impl::adopt_rfb(const PendingConnection& connection, bool head_chec
   // for every silent connection (so a flood of idle connections costs nothing once the slots are taken).
   if (clients.load() >= options.max_clients) {
     if (full_refusals++ == 0) {
-      rfbsim::log::info("rfbsim.server", "refusing clients: %d of %d already connected (logged once until "
-                   "one is accepted)", clients.load(), options.max_clients);
+      rfbsim::log::info("rfbsim.server",
+                        "refusing clients: %d of %d already connected (logged once until "
+                        "one is accepted)",
+                        clients.load(), options.max_clients);
     }
     ::close(fd);
     return;
@@ -251,7 +255,8 @@ void Server::Impl::adopt_rfb(const PendingConnection& connection, bool head_chec
   // the socket itself; our duplicate keeps the watchdog's descriptor valid meanwhile.
   const int guard = ::fcntl(fd, F_DUPFD_CLOEXEC, 0);
   if (guard < 0) {
-    rfbsim::log::limited(rfbsim::log::Level::kWarn, "out-of-fds", "rfbsim.server", "refusing a client: out of file descriptors");
+    rfbsim::log::limited(rfbsim::log::Level::kWarn, "out-of-fds", "rfbsim.server",
+                         "refusing a client: out of file descriptors");
     ::close(fd);
     return;
   }

@@ -121,8 +121,8 @@ void RegistryClient::resolve(const std::shared_ptr<Remote>& remote) {
         if (!ec && !results.empty()) {
           const tcp::endpoint found = results.begin()->endpoint();
           if (remote->endpoint != found) {
-            rfbsim::log::info("registry", "peer %s: %s is %s", remote->peer.id.c_str(),
-                         remote->peer.address.c_str(), found.address().to_string().c_str());
+            rfbsim::log::info("registry", "peer %s: %s is %s", remote->peer.id.c_str(), remote->peer.address.c_str(),
+                              found.address().to_string().c_str());
           }
           remote->endpoint = found;
           remote->warned = false;
@@ -130,7 +130,7 @@ void RegistryClient::resolve(const std::shared_ptr<Remote>& remote) {
         }
         if (!remote->warned) {
           rfbsim::log::warn("registry", "peer %s: cannot resolve %s (%s); it counts as down until it does\n",
-                       remote->peer.id.c_str(), remote->peer.address.c_str(), ec.message().c_str());
+                            remote->peer.id.c_str(), remote->peer.address.c_str(), ec.message().c_str());
           remote->warned = true;
         }
         // Never resolved: keep trying in the background. Resolved before: keep the last address.
@@ -211,7 +211,8 @@ void RegistryClient::ask(const std::shared_ptr<Phase>& phase, const std::shared_
     const MessageParse parsed = parse_message(line, key_);
     // A wrong answer is no vote: an error line, another secret or peer list, an answer to another question.
     if (!parsed.message || !answers_request(*parsed.message, exchange->request, peers_)) {
-      rfbsim::log::limited(rfbsim::log::Level::kWarn, "registry-bad-answer", "registry", "peer %s answered '%.80s'; not counted", id.c_str(), line.c_str());
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "registry-bad-answer", "registry",
+                           "peer %s answered '%.80s'; not counted", id.c_str(), line.c_str());
       return answered(phase, id, std::nullopt);
     }
     answered(phase, id, parsed.message);
@@ -284,8 +285,8 @@ void RegistryClient::settle(const std::shared_ptr<Phase>& phase) {
 
 void RegistryClient::retry_or_give_up(const std::shared_ptr<Round>& round) {
   if (round->attempt >= kAttempts) {
-    rfbsim::log::warn("registry", "uid %s: no home %s after %d ballots; the participant retries",
-                 round->uid.c_str(), round->learn_only ? "learned" : "decided", round->attempt);
+    rfbsim::log::warn("registry", "uid %s: no home %s after %d ballots; the participant retries", round->uid.c_str(),
+                      round->learn_only ? "learned" : "decided", round->attempt);
     round->done(LearnResult{});
     return;
   }

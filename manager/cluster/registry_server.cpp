@@ -14,9 +14,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "http/accept_pause.hpp"
-#include "cluster/uid_registry.hpp"
 #include "admission/unix_time.hpp"
+#include "cluster/uid_registry.hpp"
+#include "http/accept_pause.hpp"
 #include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
@@ -96,8 +96,7 @@ void RegistryServer::handle(const RegistryMessage& request, Answered done) {
       if (state != before) store_.set_uid_acceptor(request.uid, state, std::chrono::system_clock::now());
       answer = std::move(reply);
     } catch (const std::exception& error) {
-      rfbsim::log::warn("registry", "cannot keep the acceptor state of uid %s: %s", request.uid.c_str(),
-                   error.what());
+      rfbsim::log::warn("registry", "cannot keep the acceptor state of uid %s: %s", request.uid.c_str(), error.what());
     }
     asio::post(io_, [done = std::move(done), answer = std::move(answer)] { done(answer); });
   });
@@ -147,8 +146,9 @@ void RegistryServer::serve(tcp::socket socket) {
             parsed.message ? request_problem(*parsed.message, self_, peers_, unix_seconds_now()) : parsed.error;
         if (!problem.empty()) {
           // A bad hmac from a real peer means another secret or another cluster_peers list on that host.
-          rfbsim::log::limited(rfbsim::log::Level::kWarn, "registry-refused", "registry", "refused a request: %s%s", problem.c_str(),
-                       problem == "bad hmac" ? " (another cluster_secret_file or cluster_peers list?)" : "");
+          rfbsim::log::limited(rfbsim::log::Level::kWarn, "registry-refused", "registry", "refused a request: %s%s",
+                               problem.c_str(),
+                               problem == "bad hmac" ? " (another cluster_secret_file or cluster_peers list?)" : "");
           answer(connection, error_line(problem));
           return;
         }
@@ -186,7 +186,7 @@ std::string read_cluster_secret(const std::string& path) {
   struct stat status{};
   if (::stat(path.c_str(), &status) == 0 && (status.st_mode & 077) != 0) {
     rfbsim::log::warn("registry", "warning: %s may be read by other users; chmod 600 it (docs/security.md)",
-                 path.c_str());
+                      path.c_str());
   }
   return secret;
 }

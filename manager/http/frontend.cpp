@@ -23,9 +23,9 @@
 #include "http/tls_context.hpp"
 #include "http/web_policy.hpp"
 #include "http/websocket_gate.hpp"
+#include "rfbsim/log.hpp"
 #include "sessions/session_views.hpp"
 #include "static_files.hpp"
-#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -113,7 +113,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
     try {
       work();
     } catch (const std::exception& error) {
-      rfbsim::log::limited(rfbsim::log::Level::kWarn, "handler-exception", "manager", "%s failed: %s; its connection is closed", what, error.what());
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "handler-exception", "manager",
+                           "%s failed: %s; its connection is closed", what, error.what());
       websocketpp::lib::error_code ec;
       auto con = server_.get_con_from_hdl(hdl, ec);
       if (!ec) con->terminate(ec);
@@ -228,13 +229,13 @@ class FrontendImpl final : public Frontend, public SessionListener {
     refuse(con, 404, Rejection::kBadRequest, "Not found", "There is nothing at this address.");
   }
 
-
   void handle_start(const ConnectionPtr& con, const Route& route) {
     // Read while the browser is surely there: after a claim round it may have left. The whole address is
     // hashed into the index; its abuse key (an IPv6 address's /64) counts in the limits.
     const std::string participant = intake_.participant_address_of(con);
     const std::string address = PublicIntake<Server>::abuse_key(participant);
-    StartDecision decision = admission_.decide(route.query, address, std::chrono::steady_clock::now(), unix_seconds_now());
+    StartDecision decision =
+        admission_.decide(route.query, address, std::chrono::steady_clock::now(), unix_seconds_now());
     if (decision.kind != StartDecision::Kind::kAdmitted) {
       reply(con, answer_refused_start(decision));
       return;
@@ -297,7 +298,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
       in.has_session = supervisor_.has_session_for_uid(uid);
     } catch (const std::exception& error) {
       rfbsim::log::warn("manager", "/start of uid %s: cannot read the index (%s); asked to retry\n", uid.c_str(),
-                   error.what());
+                        error.what());
     }
     in.shutting_down = supervisor_.shutting_down();
     in.draining = supervisor_.draining();
@@ -427,8 +428,8 @@ class FrontendImpl final : public Frontend, public SessionListener {
     if (!admin_post_allowed(con)) return;
     if (supervisor_.draining() != drain) {
       rfbsim::log::info("manager", "%s by the administrator (%zu live session(s))",
-                   drain ? "draining: no new participants" : "taking new participants again",
-                   supervisor_.table().size());
+                        drain ? "draining: no new participants" : "taking new participants again",
+                        supervisor_.table().size());
     }
     supervisor_.set_draining(drain);
     respond_json(con, 200, host_json());

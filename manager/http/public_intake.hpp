@@ -16,11 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "admin/metrics.hpp"
+#include "config/config.hpp"
 #include "http/accept_pause.hpp"
 #include "http/client_address.hpp"
-#include "config/config.hpp"
 #include "http/connection_limits.hpp"
-#include "admin/metrics.hpp"
 #include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
@@ -135,7 +135,7 @@ class PublicIntake {
     metrics_.count_accept_error();
     if (!paused_) {
       rfbsim::log::warn("manager", "accepting connections failed (%s); pausing %lld ms between tries\n", why.c_str(),
-                   static_cast<long long>(kAcceptPause.count()));
+                        static_cast<long long>(kAcceptPause.count()));
     }
     paused_ = true;
     pause_.expires_after(kAcceptPause);
@@ -181,8 +181,9 @@ class PublicIntake {
       const auto now = std::chrono::steady_clock::now();
       if (now - last_refusal_log_ >= intake_detail::kRefusalLogInterval) {
         last_refusal_log_ = now;
-        rfbsim::log::limited(rfbsim::log::Level::kWarn, "connection-cap", "manager", "refused connections over the cap (%zu open, %zu from %s)",
-                     limits_.open_total(), limits_.open(key), key.c_str());
+        rfbsim::log::limited(rfbsim::log::Level::kWarn, "connection-cap", "manager",
+                             "refused connections over the cap (%zu open, %zu from %s)", limits_.open_total(),
+                             limits_.open(key), key.c_str());
       }
       socket.close(ec);
       return;

@@ -22,9 +22,9 @@
 #include "http/relay.hpp"
 #include "http/routes.hpp"
 #include "http/web_policy.hpp"
+#include "rfbsim/log.hpp"
 #include "sessions/session_views.hpp"
 #include "sessions/supervisor.hpp"
-#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -279,8 +279,9 @@ class WebSocketGate {
     for (auto& [hdl, relay] : relays) {
       if (relay->session_id() != session.id || relay->kind() != RelayKind::kParticipant) continue;
       metrics_.count_takeover();
-      rfbsim::log::limited(rfbsim::log::Level::kInfo, "takeover", "manager", "session %lld (uid %s): a newer browser took over; the earlier one is told",
-                   static_cast<long long>(session.id), session.uid.c_str());
+      rfbsim::log::limited(rfbsim::log::Level::kInfo, "takeover", "manager",
+                           "session %lld (uid %s): a newer browser took over; the earlier one is told",
+                           static_cast<long long>(session.id), session.uid.c_str());
       relay->close(static_cast<websocketpp::close::status::value>(websocket_gate_detail::kTakenOverCode), websocket_gate_detail::kTakenOverReason);
     }
   }

@@ -17,9 +17,9 @@
 #include <fstream>
 #include <optional>
 
+#include "rfbsim/log.hpp"
 #include "sessions/session.hpp"
 #include "sessions/session_process.hpp"
-#include "rfbsim/log.hpp"
 
 namespace rfbsim::manager {
 
@@ -41,8 +41,8 @@ const std::vector<std::string> kCopyVariables = {"USER", "LOGNAME", "SSH_AUTH_SO
                                                  "XDG_CONFIG_HOME"};
 
 void log_copy(const CopyJob& job, const std::string& text) {
-  rfbsim::log::info("manager", "session %lld (uid %s): %s", static_cast<long long>(job.session_id),
-               job.uid.c_str(), text.c_str());
+  rfbsim::log::info("manager", "session %lld (uid %s): %s", static_cast<long long>(job.session_id), job.uid.c_str(),
+                    text.c_str());
 }
 
 // The last non-empty line of `file` from byte `from` on (what this try's command wrote), at most

@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // A session's end: timers, stopping its process, reaping, the log tail, the X11 display's clean-up, the
 // after-session copy; and the participant's presence, which the idle timer follows.
-#include "sessions/supervisor.hpp"
-
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
@@ -23,15 +21,16 @@
 #include <stdexcept>
 #include <thread>
 
+#include "admission/tokens.hpp"
+#include "record/digest.hpp"
+#include "rfbsim/log.hpp"
 #include "sessions/launch_plan.hpp"
 #include "sessions/process_launcher.hpp"
-#include "record/digest.hpp"
 #include "sessions/session_process.hpp"
 #include "sessions/session_views.hpp"
-#include "admission/tokens.hpp"
-#include "x11_display.hpp"
+#include "sessions/supervisor.hpp"
 #include "sessions/supervisor_runtime.hpp"
-#include "rfbsim/log.hpp"
+#include "x11_display.hpp"
 
 namespace rfbsim::manager {
 
@@ -129,8 +128,8 @@ void Supervisor::process_gone(Session& session, int wait_status) {
   session.exit_status = describe_wait_status(wait_status);
   if (session.state != SessionState::kEnding) {
     const std::string last_line = session_log_tail(session);
-    session.detail = "the program stopped by itself (" + session.exit_status + ")" +
-                     (last_line.empty() ? "" : ": " + last_line);
+    session.detail =
+        "the program stopped by itself (" + session.exit_status + ")" + (last_line.empty() ? "" : ": " + last_line);
   }
   session.state = final_state;
   session.ended_at = std::chrono::system_clock::now();

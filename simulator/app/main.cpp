@@ -26,6 +26,7 @@
 
 #include "app/frame_painter.hpp"
 #include "app/options.hpp"
+#include "app/parent_pipe.hpp"
 #include "app/ros_link.hpp"
 #include "app/ros_setup.hpp"
 #include "app/session_setup.hpp"
@@ -35,12 +36,11 @@
 #include "contract/ready_line.hpp"
 #include "record/digest.hpp"
 #include "record/session_writer.hpp"
+#include "rfbsim/log.hpp"
 #include "rfbsim/offscreen_gl.hpp"
 #include "rfbsim/server.hpp"
 #include "scenario/scenario.hpp"
 #include "world/fixed_step_clock.hpp"
-#include "rfbsim/log.hpp"
-#include "app/parent_pipe.hpp"
 
 namespace {
 
@@ -117,8 +117,7 @@ class StreamReporter {
     const std::string error = write_line(fd_, line);
     if (error.empty()) return;
     failed_ = true;
-    rfbsim::log::warn("sim_rfb", "cannot report the stream to the parent: %s; no more stream lines",
-                 error.c_str());
+    rfbsim::log::warn("sim_rfb", "cannot report the stream to the parent: %s; no more stream lines", error.c_str());
   }
 
   int fd_;
@@ -201,7 +200,7 @@ rfbsim::sim::SessionSetup setup_of(const rfbsim::sim::SimOptions& options) {
 void log_robot_events(const rfbsim::sim::World& world, double dt) {
   for (const rfbsim::sim::RobotEvent& event : world.robot_events) {
     rfbsim::log::info("robot", "%.2f s %s: %s", static_cast<double>(event.tick) * dt,
-                 rfbsim::sim::robot_state_name(event.state), event.detail.c_str());
+                      rfbsim::sim::robot_state_name(event.state), event.detail.c_str());
   }
 }
 
@@ -232,15 +231,16 @@ int run(const rfbsim::sim::SimOptions& options) {
   sim::Simulation& simulation = *prepared.simulation;
   if (!options.scenario.empty()) {
     rfbsim::log::info("sim_rfb", "scenario %s (%s), seed %llu, %zu people", prepared.info.scenario.c_str(),
-                 prepared.info.scenario_file.c_str(), static_cast<unsigned long long>(prepared.info.seed),
-                 simulation.world().people.size());
+                      prepared.info.scenario_file.c_str(), static_cast<unsigned long long>(prepared.info.seed),
+                      simulation.world().people.size());
   }
   std::unique_ptr<sim::RosLink> ros_link = sim::open_ros_link(options);
   const sim::RobotStack* robot_stack = simulation.robot_stack();
   if (robot_stack && robot_stack->control() == sim::RobotControl::kExternal && !options.rosbridge_port &&
       options.rosbridge_connect.empty()) {
-    rfbsim::log::warn("ros", "warning: the robot is under external control but no rosbridge is configured "
-                         "(--rosbridge-port or --rosbridge-connect): nothing can drive it, and it will stand still");
+    rfbsim::log::warn("ros",
+                      "warning: the robot is under external control but no rosbridge is configured "
+                      "(--rosbridge-port or --rosbridge-connect): nothing can drive it, and it will stand still");
   }
   // Session data from the first tick on, when asked for.
   std::unique_ptr<sim::SessionWriter> writer;
@@ -303,8 +303,9 @@ int run(const rfbsim::sim::SimOptions& options) {
   ClientChanges client_changes;
   // The log names the participant's address only hashed, as the session data does.
   server_options.on_connect = [&client_changes, &address_key](const rfbsim::ClientInfo& c) {
-    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-connected", "sim_rfb", "client %d connected, address %s (%s)", c.id,
-                 sim::hash_address(address_key, c.address).c_str(), c.websocket ? "websocket" : "rfb");
+    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-connected", "sim_rfb",
+                         "client %d connected, address %s (%s)", c.id,
+                         sim::hash_address(address_key, c.address).c_str(), c.websocket ? "websocket" : "rfb");
     client_changes.push(true, c);
   };
   server_options.on_disconnect = [&client_changes](const rfbsim::ClientInfo& c) {
@@ -320,7 +321,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   rfbsim::OffscreenGL gl(gl_options);
   rfbsim::log::info("sim_rfb", "rendering with %s", gl.renderer().c_str());
   rfbsim::log::info("sim_rfb", "picture encoding %s, %d frames per second while watched", options.codec.c_str(),
-               options.fps);
+                    options.fps);
 
   sim::FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / options.tick_hz));
   const auto frame_interval = std::chrono::nanoseconds(1'000'000'000LL / options.fps);
@@ -397,7 +398,7 @@ int run(const rfbsim::sim::SimOptions& options) {
       if (const auto failure = ros_link->bag_failure(); failure && !bag_failure_told) {
         bag_failure_told = true;
         rfbsim::log::info("ros", "session.mcap stopped growing: %s (the session and its other files go on)",
-                     failure->c_str());
+                          failure->c_str());
       }
     }
     for (int i = 0; i < ticks && !study.over(); ++i) {
@@ -449,8 +450,8 @@ int run(const rfbsim::sim::SimOptions& options) {
   if (options.ready_fd) ::close(*options.ready_fd);
   rfbsim::log::flush_suppressed();  // what the rate limit held back is counted before the last line
   rfbsim::log::info("sim_rfb", "stopping after %llu ticks, %llu frames (%s)",
-               static_cast<unsigned long long>(simulation.world().tick),
-               static_cast<unsigned long long>(frames_rendered), end_reason.c_str());
+                    static_cast<unsigned long long>(simulation.world().tick),
+                    static_cast<unsigned long long>(frames_rendered), end_reason.c_str());
   return 0;
 }
 

@@ -4,12 +4,12 @@
 
 #include <cstdio>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
 #include <utility>
 
-#include <nlohmann/json.hpp>
-
+#include "rfbsim/log.hpp"
 #include "ros/bridge/rosbridge_client.hpp"
 #include "ros/bridge/rosbridge_hub.hpp"
 #include "ros/bridge/rosbridge_server.hpp"
@@ -18,7 +18,6 @@
 #include "ros/msgs/ros_json.hpp"
 #include "ros/msgs/ros_schemas.hpp"
 #include "ros/msgs/ros_topics.hpp"
-#include "rfbsim/log.hpp"
 
 namespace rfbsim::sim {
 

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // sim_rfb's ROS side from its command line.
 #include "app/ros_setup.hpp"
-#include "rfbsim/log.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -12,6 +11,8 @@
 #include <fstream>
 #include <stdexcept>
 #include <utility>
+
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::sim {
 
@@ -53,8 +54,10 @@ bool room_for_bag(const std::filesystem::path& dir) {
   std::error_code ec;
   const std::filesystem::space_info space = std::filesystem::space(dir, ec);
   if (ec || space.available >= kBagMinFreeBytes) return true;  // unknown: the writer thread checks each chunk
-  rfbsim::log::info("ros", "%s has %ju KiB free, under the bag's 64 MiB floor: no session.mcap; the session's "
-                       "other files keep the space", dir.c_str(), static_cast<std::uintmax_t>(space.available >> 10));
+  rfbsim::log::info("ros",
+                    "%s has %ju KiB free, under the bag's 64 MiB floor: no session.mcap; the session's "
+                    "other files keep the space",
+                    dir.c_str(), static_cast<std::uintmax_t>(space.available >> 10));
   return false;
 }
 
@@ -85,7 +88,7 @@ std::unique_ptr<RosLink> open_ros_link(const SimOptions& options) {
   auto link = std::make_unique<RosLink>(std::move(ros));
   if (const auto port = link->server_port()) {
     rfbsim::log::info("ros", "rosbridge v2 server on ws://%s:%d/ (unauthenticated: keep it on loopback)",
-                 url_host(options.rosbridge_bind).c_str(), *port);
+                      url_host(options.rosbridge_bind).c_str(), *port);
   }
   if (!options.rosbridge_connect.empty()) {
     rfbsim::log::info("ros", "rosbridge client dialling %s", options.rosbridge_connect.c_str());
