@@ -154,8 +154,7 @@ constexpr int kReaderBusyTimeoutMs = 100;
 
 int run(ManagerConfig config) {
   namespace manager = rfbsim::manager;
-  rfbsim::log::Level log_level = rfbsim::log::Level::kInfo;
-  if (rfbsim::log::parse_level(config.log_level, log_level)) rfbsim::log::set_level(log_level);
+  rfbsim::log::set_level(config.log_level);  // checked by the config's reader
   const std::string program = config.session_kind == rfbsim::manager::SessionKind::kX11
                                   ? resolve_x11_session(config)
                                   : resolve_program(config.session_command);

@@ -72,14 +72,6 @@ void write_suppressed_locked(Sink& sink, const std::string& kind, KindState& sta
   state.suppressed = 0;
 }
 
-void vwrite(Level level, const char* tag, const char* format, va_list args) {
-  if (!enabled(level)) return;
-  const std::string text = formatted(format, args);
-  Sink& sink = state();
-  std::lock_guard<std::mutex> lock(sink.mutex);
-  emit_locked(sink, tag, text);
-}
-
 }  // namespace
 
 void set_level(Level level) { current_level.store(static_cast<int>(level)); }
@@ -96,12 +88,27 @@ bool parse_level(std::string_view text, Level& out) {
   return false;
 }
 
+bool set_level(std::string_view name) {
+  Level named{};
+  if (!parse_level(name, named)) return false;
+  set_level(named);
+  return true;
+}
+
 void write(Level level, std::string_view tag, std::string_view text) {
   if (!enabled(level)) return;
   Sink& sink = state();
   std::lock_guard<std::mutex> lock(sink.mutex);
   emit_locked(sink, tag, text);
 }
+
+namespace {
+
+void vwrite(Level level, const char* tag, const char* format, va_list args) {
+  if (enabled(level)) write(level, tag, formatted(format, args));
+}
+
+}  // namespace
 
 #define RFBSIM_LOG_AT(name, lvl)                    \
   void name(const char* tag, const char* format, ...) { \

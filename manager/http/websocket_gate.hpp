@@ -122,12 +122,6 @@ class WebSocketGate {
     for (auto& [hdl, relay] : relays) relay->close(websocketpp::close::status::going_away, "server shutting down");
   }
 
-  /// websocketpp's validate handler: whether the upgrade may go on (else the response is set here).
-  bool validate(const ConnectionPtr& con) { return validate_websocket(con); }
-  /// websocketpp's open handler: the socket gets its relay.
-  void open(connection_hdl hdl) { open_websocket(hdl); }
-  /// websocketpp's close and fail handlers.
-  void forget(connection_hdl hdl) { forget_websocket(hdl); }
   /// A message from a browser, carried to its session.
   void from_browser(connection_hdl hdl, std::string&& payload) {
     const auto it = relays_.find(hdl);
@@ -143,7 +137,7 @@ class WebSocketGate {
 
   void session_closing(const Session& session) {
     const CloseNotice notice = close_notice(coming_state(session));
-    auto relays = relays_;  // closing may call back into forget_websocket
+    auto relays = relays_;  // closing may call back into forget
     for (auto& [hdl, relay] : relays) {
       if (relay->session_id() == session.id) relay->close(notice);
     }
@@ -179,7 +173,9 @@ class WebSocketGate {
     return false;
   }
 
-  bool validate_websocket(const ConnectionPtr& con) {
+ public:
+  /// websocketpp's validate handler: whether the upgrade may go on (else the response is set here).
+  bool validate(const ConnectionPtr& con) {
     const auto decision = upgrade_limiter_.take(intake_.client_address_of(con), std::chrono::steady_clock::now());
     if (!decision.allowed) {
       con->replace_header("Retry-After", std::to_string(decision.retry_after.count()));
@@ -228,7 +224,8 @@ class WebSocketGate {
     return true;
   }
 
-  void open_websocket(connection_hdl hdl) {
+  /// websocketpp's open handler: the socket gets its relay.
+  void open(connection_hdl hdl) {
     const auto pending = pending_.find(hdl);
     if (pending == pending_.end()) return;
     const std::string session_token = pending->second.token;
@@ -264,7 +261,8 @@ class WebSocketGate {
     if (session->state == SessionState::kRunning) relay->connect(session->port, session->unix_socket);
   }
 
-  void forget_websocket(connection_hdl hdl) {
+  /// websocketpp's close and fail handlers.
+  void forget(connection_hdl hdl) {
     pending_.erase(hdl);
     const auto it = relays_.find(hdl);
     if (it == relays_.end()) return;
@@ -274,8 +272,9 @@ class WebSocketGate {
     if (relay->kind() == RelayKind::kParticipant) supervisor_.client_disconnected(relay->session_id());
   }
 
+ private:
   void take_over_from_earlier(const Session& session) {
-    auto relays = relays_;  // closing calls back into forget_websocket
+    auto relays = relays_;  // closing calls back into forget
     for (auto& [hdl, relay] : relays) {
       if (relay->session_id() != session.id || relay->kind() != RelayKind::kParticipant) continue;
       metrics_.count_takeover();

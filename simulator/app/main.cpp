@@ -468,8 +468,7 @@ int main(int argc, char** argv) {
     std::fputs(rfbsim::sim::sim_usage().c_str(), stdout);
     return 0;
   }
-  rfbsim::log::Level log_level = rfbsim::log::Level::kInfo;
-  if (rfbsim::log::parse_level(parsed.options.log_level, log_level)) rfbsim::log::set_level(log_level);
+  rfbsim::log::set_level(parsed.options.log_level);  // checked by the parser
   install_signal_handlers();
   try {
     return run(parsed.options);

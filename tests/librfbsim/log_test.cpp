@@ -82,3 +82,14 @@ TEST_CASE("log: suppressed counts are written at a flush, and lines from many th
   REQUIRE(log.lines.size() == 3);
   CHECK(log.lines[2] == "[sim] 398 more like this suppressed (flood)");
 }
+
+TEST_CASE("log: a level set by name takes effect, and a bad name changes nothing") {
+  CapturedLog log;
+  CHECK(rfbsim::log::set_level(std::string_view("warn")));
+  CHECK(rfbsim::log::level() == rfbsim::log::Level::kWarn);
+  CHECK_FALSE(rfbsim::log::set_level(std::string_view("loud")));
+  CHECK(rfbsim::log::level() == rfbsim::log::Level::kWarn);
+  rfbsim::log::info("t", "hidden");
+  rfbsim::log::warn("t", "shown");
+  CHECK(log.lines == std::vector<std::string>{"[t] shown"});
+}

@@ -23,6 +23,8 @@ void set_level(Level level);
 
 /// "error", "warn", "info" or "debug" into `out`; false for anything else.
 [[nodiscard]] bool parse_level(std::string_view text, Level& out);
+/// Sets the level a --log-level option named; false (and the level unchanged) for a name parse_level refuses.
+bool set_level(std::string_view name);
 /// The names parse_level takes, for a --log-level option's help and choices.
 inline constexpr const char* kLevelNames[] = {"error", "warn", "info", "debug"};
 
