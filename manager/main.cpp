@@ -299,6 +299,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "sim_manager: %s\n(sim_manager --help lists the options)\n", parsed.error.c_str());
     return 2;
   }
+  if (parsed.print_config) {
+    std::fputs(manager::print_config(parsed.config).c_str(), stdout);
+    return 0;
+  }
   if (!parsed.sign_query.empty()) {
     if (parsed.config.link_secret.empty()) {
       std::fprintf(stderr, "sim_manager: --sign needs a link secret (--link-secret, the config or RFBSIM_LINK_SECRET)\n");

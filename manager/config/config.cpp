@@ -27,9 +27,8 @@
 
 namespace rfbsim::manager {
 
-using config_table::flag_to_key;
+using config_table::find_setting;
 using config_table::parse_integer;
-using config_table::settings;
 using config_table::split_commas;
 
 const char* session_kind_name(SessionKind kind) {
@@ -58,6 +57,24 @@ ProcessLimits session_limits(const ManagerConfig& config) {
   return limits;
 }
 
+namespace {
+
+// The keys a section of the file holds (connect, token_file, ... for ros), as the table declares them; none for
+// a key that is not a section.
+std::vector<std::string> section_names(const std::string& section) {
+  std::vector<std::string> names;
+  if (std::find(config_table::kSections.begin(), config_table::kSections.end(), section) ==
+      config_table::kSections.end()) {
+    return names;
+  }
+  for (const config_table::Setting& setting : config_table::settings()) {
+    if (setting.key.rfind(section + "_", 0) == 0) names.push_back(setting.key.substr(section.size() + 1));
+  }
+  return names;
+}
+
+}  // namespace
+
 ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
   ConfigOutcome outcome;
   outcome.config = std::move(base);
@@ -80,13 +97,13 @@ ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
   const auto apply = [&](const std::string& key, const std::string& shown, const YAML::Node& name,
                          const YAML::Node& node) -> bool {
     const std::string where = path + ":" + std::to_string(name.Mark().line + 1) + ": " + shown + ": ";
-    const auto setting = settings().find(key);
-    if (setting == settings().end()) {
+    const config_table::Setting* setting = find_setting(key);
+    if (setting == nullptr) {
       outcome.error = where + "unknown setting";
       return false;
     }
     std::vector<std::string> values;
-    if (setting->second.list && node.IsSequence()) {
+    if (setting->kind.list && node.IsSequence()) {
       for (const auto& element : node) {
         if (!element.IsScalar()) {
           outcome.error = where + "expected a list of plain values";
@@ -96,13 +113,13 @@ ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
       }
     } else if (node.IsScalar()) {
       values.push_back(node.Scalar());
-      if (setting->second.list) values = split_commas(node.Scalar());
+      if (setting->kind.list) values = split_commas(node.Scalar());
     } else {
-      outcome.error = where + (setting->second.list ? "expected a list" : "expected a single value");
+      outcome.error = where + (setting->kind.list ? "expected a list" : "expected a single value");
       return false;
     }
-    if (!setting->second.list && values.empty()) values.emplace_back();
-    const std::string problem = setting->second.apply(outcome.config, values);
+    if (!setting->kind.list && values.empty()) values.emplace_back();
+    const std::string problem = setting->kind.apply(outcome.config, values);
     if (!problem.empty()) {
       outcome.error = where + problem;
       return false;
@@ -118,23 +135,20 @@ ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
     const std::string line = path + ":" + std::to_string(item.first.Mark().line + 1) + ": ";
     // The ros and x11 sections are mappings of their own (ros: {connect: ...}); their keys are the table's
     // <section>_<key>, which the file names only that way, so that one setting has one spelling there.
-    static const std::map<std::string, std::vector<std::string>> kSections = {
-        {"ros", {"connect", "token_file", "ca_file", "namespace", "robot_control", "cmd_vel_type"}},
-        {"x11", {"geometry", "depth", "xvnc"}}};
-    for (const auto& [section, keys] : kSections) {
+    for (const std::string& section : config_table::kSections) {
       if (key.rfind(section + "_", 0) == 0) {
         outcome.error = line + key + ": unknown setting (write it as " + key.substr(section.size() + 1) + ": under " +
                         section + ":)";
         return outcome;
       }
     }
-    const auto section = kSections.find(key);
-    if (section == kSections.end()) {
+    const std::vector<std::string> names = section_names(key);
+    if (names.empty()) {
       if (!apply(key, key, item.first, item.second)) return outcome;
       continue;
     }
     std::string known;
-    for (const std::string& name : section->second) known += (known.empty() ? "" : ", ") + name;
+    for (const std::string& name : names) known += (known.empty() ? "" : ", ") + name;
     if (!item.second.IsMap()) {
       outcome.error = line + key + ": expected a mapping (" + known + ")";
       return outcome;
@@ -146,101 +160,13 @@ ConfigOutcome load_config_file(const std::string& path, ManagerConfig base) {
         return outcome;
       }
       const std::string name = sub.first.Scalar();
-      if (std::find(section->second.begin(), section->second.end(), name) == section->second.end()) {
+      if (std::find(names.begin(), names.end(), name) == names.end()) {
         outcome.error = at + key + "." + name + ": unknown setting (known: " + known + ")";
         return outcome;
       }
       if (!apply(key + "_" + name, key + "." + name, sub.first, sub.second)) return outcome;
     }
   }
-  return outcome;
-}
-
-ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
-                                 const std::vector<std::pair<std::string, std::string>>& environment) {
-  ConfigOutcome outcome;
-  // The config file first, wherever --config stands, so that flags always win over it.
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] != "--config") continue;
-    if (i + 1 >= args.size()) {
-      outcome.error = "--config needs a file";
-      return outcome;
-    }
-    outcome = load_config_file(args[i + 1], outcome.config);
-    if (!outcome.error.empty()) return outcome;
-  }
-  bool session_args_from_flags = false;
-  bool copy_command_from_flags = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& flag = args[i];
-    if (flag == "--help" || flag == "-h") {
-      outcome.help = true;
-      return outcome;
-    }
-    if (flag.rfind("--", 0) != 0) {
-      outcome.error = "unexpected argument '" + flag + "'";
-      return outcome;
-    }
-    if (i + 1 >= args.size()) {
-      outcome.error = flag + " needs a value";
-      return outcome;
-    }
-    const std::string& value = args[++i];
-    if (flag == "--config") continue;
-    if (flag == "--sign") {
-      outcome.sign_query = value;
-      continue;
-    }
-    if (flag == "--session-arg") {
-      // Repeated: the flags' list replaces the file's as a whole.
-      if (!session_args_from_flags) outcome.config.session_args.clear();
-      session_args_from_flags = true;
-      outcome.config.session_args.push_back(value);
-      continue;
-    }
-    if (flag == "--after-session-command") {
-      // Repeated, one argument each (a path or an rclone flag may hold a comma); the flags' list replaces the
-      // file's as a whole, and is checked once it is complete (below).
-      if (!copy_command_from_flags) outcome.config.after_session_command.clear();
-      copy_command_from_flags = true;
-      outcome.config.after_session_command.push_back(value);
-      continue;
-    }
-    const auto setting = settings().find(flag_to_key(flag));
-    if (setting == settings().end() || flag_to_key(flag) == "session_args") {
-      outcome.error = "unknown option '" + flag + "'";
-      return outcome;
-    }
-    const std::vector<std::string> values =
-        setting->second.list ? split_commas(value) : std::vector<std::string>{value};
-    const std::string problem = setting->second.apply(outcome.config, values);
-    if (!problem.empty()) {
-      // Secrets are never echoed: error messages end up in logs and terminals.
-      const bool secret = setting->first == "admin_token" || setting->first == "link_secret";
-      outcome.error = flag + (secret ? "" : " '" + value + "'") + ": " + problem;
-      return outcome;
-    }
-  }
-  // Secrets from the environment (e.g. a systemd EnvironmentFile) keep them out of `ps`.
-  for (const auto& [name, value] : environment) {
-    const char* key = name == "RFBSIM_ADMIN_TOKEN" ? "admin_token" : name == "RFBSIM_LINK_SECRET" ? "link_secret" : nullptr;
-    if (key == nullptr) continue;
-    std::string& field = name == "RFBSIM_ADMIN_TOKEN" ? outcome.config.admin_token : outcome.config.link_secret;
-    if (!field.empty()) continue;
-    const std::string problem = settings().at(key).apply(outcome.config, {value});
-    if (!problem.empty()) {
-      outcome.error = name + ": " + problem;
-      return outcome;
-    }
-  }
-  // In a cluster each host owns "/<host_id>" of the balancer's URL space unless told otherwise (the balancer
-  // routes /<id>/... to host <id>, and a registry answer sends a participant to /<id>/start).
-  ManagerConfig& config = outcome.config;
-  if (config.path_prefix.empty() && !config.cluster_peers.empty() && is_path_prefix("/" + config.host_id)) {
-    config.path_prefix = "/" + config.host_id;
-  }
-  finish_config(config);
-  if (outcome.error.empty()) outcome.error = validate_config(outcome.config);
   return outcome;
 }
 

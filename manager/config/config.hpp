@@ -172,13 +172,15 @@ struct ConfigOutcome {
   std::string error;  ///< empty on success
   bool help = false;  ///< --help was given
   std::string sign_query;  ///< --sign QUERY was given: print the signed query and exit
+  bool print_config = false;  ///< --print-config was given: print the settings as a config file and exit
 };
 
 /// Reads a YAML config file over `base`. Unknown keys and bad values are errors naming the key and line.
 ConfigOutcome load_config_file(const std::string& path, ManagerConfig base);
 
 /// Parses the command line (without the program name): --config FILE first, then flags over it, then
-/// RFBSIM_ADMIN_TOKEN and RFBSIM_LINK_SECRET from `environment` where the flags left them empty.
+/// RFBSIM_ADMIN_TOKEN and RFBSIM_LINK_SECRET from `environment` where the flags left them empty (or as the
+/// placeholder --print-config writes; that placeholder is refused unless --print-config is given).
 ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
                                  const std::vector<std::pair<std::string, std::string>>& environment = {});
 
@@ -208,8 +210,12 @@ std::chrono::seconds session_time_needed(const ManagerConfig& config, const Scen
 /// each scenario whose task it can cut short and the seconds that one needs ("" when none).
 std::string fit_max_duration(ManagerConfig& config);
 
-/// The --help text.
+/// The --help text, from the settings table.
 std::string manager_usage();
+
+/// The settings of `config` as a YAML config file, in the table's order: each setting that is set, and each unset
+/// one as a comment; secrets as <set>. Read back (with the same environment), it prints the same text.
+std::string print_config(const ManagerConfig& config);
 
 /// "sim_rfb", "rfb" or "x11".
 const char* session_kind_name(SessionKind kind);

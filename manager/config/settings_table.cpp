@@ -1,28 +1,21 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "config/settings_table.hpp"
 
-#include "rfbsim/log.hpp"
-
-#include <arpa/inet.h>
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
-#include <functional>
-#include <map>
 #include <optional>
 
-#include "http/client_address.hpp"
-#include "sessions/copy_command.hpp"
-#include "sessions/launch_plan.hpp"
-#include "config/ros_settings.hpp"
-#include "contract/task_bounds.hpp"
-#include "contract/validators.hpp"
-#include "http/routes.hpp"
 #include "admission/start_request.hpp"
+#include "config/ros_settings.hpp"
+#include "config/setting_kinds.hpp"
+#include "contract/validators.hpp"
+#include "http/client_address.hpp"
+#include "http/routes.hpp"
 #include "cluster/uid_registry.hpp"
+#include "rfbsim/log.hpp"
+#include "sessions/copy_command.hpp"
 
 namespace rfbsim::manager::config_table {
 
@@ -31,366 +24,349 @@ namespace {
 // limits.cpu_slack_s's bound: a day of CPU beyond the session's share (a guard against typos, not a task bound).
 constexpr long long kMaxCpuSlackS = 24LL * 3600;
 
-Apply integer(int ManagerConfig::*field, int low, int high) {
-  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-    if (!parse_integer(v.front(), low, high, c.*field)) {
-      return "expected an integer " + std::to_string(low) + ".." + std::to_string(high);
-    }
+// The largest address space and descriptor limits a session may be given (far past any machine's).
+constexpr std::uint64_t kMaxAddressSpaceMb = 1ULL << 30;
+constexpr std::uint64_t kMaxOpenFiles = 1ULL << 20;
+
+using Values = std::vector<std::string>;
+using Shown = std::optional<Values>;
+
+Setting row(std::string key, ValueKind kind, std::string help, std::string default_note = {}) {
+  return {std::move(key), std::move(kind), std::move(help), std::move(default_note), false};
+}
+
+Setting secret_row(std::string key, ValueKind kind, std::string help) {
+  Setting setting = row(std::move(key), std::move(kind), std::move(help));
+  setting.secret = true;
+  return setting;
+}
+
+// The numbers --print-config writes: the shortest text that reads back as the same double.
+std::string shortest(double value) {
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return ec == std::errc() ? std::string(buffer, end) : std::to_string(value);
+}
+
+std::vector<Setting> build_table() {
+  // Kinds of value only one setting takes are written out here.
+  ValueKind max_duration = seconds(&ManagerConfig::max_duration, 1);
+  max_duration.apply = [apply = max_duration.apply](ManagerConfig& c, const Values& v) {
+    c.max_duration_set = true;  // the researcher's own limit: fit_max_duration keeps it
+    return apply(c, v);
+  };
+  // Unset, it is fitted to the scenarios' tasks at start-up: written as a number it would no longer be.
+  max_duration.show = [show = max_duration.show](const ManagerConfig& c) -> Shown {
+    return c.max_duration_set ? show(c) : std::nullopt;
+  };
+
+  ValueKind scenarios = checked_list(&ManagerConfig::scenarios, "A,B", [](const std::string& entry) -> std::string {
+    if (is_identifier(entry.substr(0, entry.find('=')))) return "";
+    return "'" + entry + "' is not a scenario name (letters, digits, - and _, at most 64), optionally =FILE";
+  });
+  scenarios.apply = [apply = scenarios.apply](ManagerConfig& c, const Values& v) -> std::string {
+    if (v.empty()) return "list at least one scenario";
+    if (std::string problem = apply(c, v); !problem.empty()) return problem;
+    c.scenarios_set = true;
     return "";
   };
-}
+  // session_kind rfb and x11 offer none unless told (finish_config): an empty list is not a value to write.
+  scenarios.show = [](const ManagerConfig& c) -> Shown {
+    return c.scenarios.empty() ? std::nullopt : Shown(c.scenarios);
+  };
 
-Apply seconds(std::chrono::seconds ManagerConfig::*field, long long low) {
-  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-    long long value = 0;
-    if (!parse_integer(v.front(), low, 7LL * 24 * 3600, value)) {
-      return "expected whole seconds " + std::to_string(low) + ".." + std::to_string(7 * 24 * 3600);
-    }
-    c.*field = std::chrono::seconds(value);
+  ValueKind address_space = limit_count(&ProcessLimits::address_space_mb, kMaxAddressSpaceMb, "MB", "MiB");
+  address_space.apply = [apply = address_space.apply](ManagerConfig& c, const Values& v) -> std::string {
+    if (std::string problem = apply(c, v); !problem.empty()) return problem;
+    c.limits.address_space_set = true;  // kept for every session kind
     return "";
   };
-}
-
-// An integer field of the abuse limits.
-Apply abuse_integer(int AbuseLimits::*field, int high) {
-  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-    if (!parse_integer(v.front(), 0, high, c.abuse.*field)) return "expected 0.." + std::to_string(high) + ", 0 = off";
-    return "";
+  address_space.show = [show = address_space.show](const ManagerConfig& c) -> Shown {
+    return c.limits.address_space_set ? show(c) : std::nullopt;
   };
-}
 
-Apply abuse_seconds(std::chrono::seconds AbuseLimits::*field) {
-  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-    long long value = 0;
-    if (!parse_integer(v.front(), 0LL, 3600LL, value)) return "expected whole seconds 0..3600, 0 = off";
-    c.abuse.*field = std::chrono::seconds(value);
-    return "";
+  const ValueKind cpu_factor{
+      "F", "0..256, 0 = no limit", false,
+      [](ManagerConfig& c, const Values& v) -> std::string {
+        double factor = 0;
+        const char* end = v.front().data() + v.front().size();
+        const auto [ptr, ec] = std::from_chars(v.front().data(), end, factor);
+        if (v.front().empty() || ec != std::errc() || ptr != end || !std::isfinite(factor) || factor < 0 ||
+            factor > 256) {
+          return "expected cores per session 0..256, 0 = no CPU limit";
+        }
+        c.limits.cpu_time_factor = factor;
+        return "";
+      },
+      [](const ManagerConfig& c) -> Shown { return Values{shortest(c.limits.cpu_time_factor)}; }};
+
+  const ValueKind cpu_slack{
+      "S", "0.." + std::to_string(kMaxCpuSlackS), false,
+      [](ManagerConfig& c, const Values& v) -> std::string {
+        long long value = 0;
+        if (!parse_integer(v.front(), 0LL, kMaxCpuSlackS, value)) {
+          return "expected whole seconds 0.." + std::to_string(kMaxCpuSlackS);
+        }
+        c.limits.cpu_slack = std::chrono::seconds(value);
+        return "";
+      },
+      [](const ManagerConfig& c) -> Shown { return Values{std::to_string(c.limits.cpu_slack.count())}; }};
+
+  const ValueKind session_args{"ARG", "", true,
+                               [](ManagerConfig& c, const Values& v) -> std::string {
+                                 c.session_args = v;
+                                 return "";
+                               },
+                               [](const ManagerConfig& c) -> Shown { return c.session_args; }};
+
+  const ValueKind after_session_command{"ARG", "", true,
+                                        [](ManagerConfig& c, const Values& v) -> std::string {
+                                          if (std::string problem = copy_command_problem(v); !problem.empty()) {
+                                            return problem;
+                                          }
+                                          c.after_session_command = v;
+                                          return "";
+                                        },
+                                        [](const ManagerConfig& c) -> Shown { return c.after_session_command; }};
+
+  const ValueKind x11_geometry{
+      "WxH", "64..8192 each", false,
+      [](ManagerConfig& c, const Values& v) -> std::string {
+        const std::string& text = v.front();
+        const std::size_t x = text.find('x');
+        int width = 0;
+        int height = 0;
+        // Xvnc needs whole pixels; a screen past 8192 would cost a participant's link more than any program.
+        if (x == std::string::npos || !parse_integer(text.substr(0, x), 64, 8192, width) ||
+            !parse_integer(text.substr(x + 1), 64, 8192, height)) {
+          return "expected WIDTHxHEIGHT, each 64..8192 (e.g. 1280x720)";
+        }
+        c.x11.width = width;
+        c.x11.height = height;
+        return "";
+      },
+      [](const ManagerConfig& c) -> Shown {
+        return Values{std::to_string(c.x11.width) + "x" + std::to_string(c.x11.height)};
+      }};
+
+  const ValueKind x11_depth{"D", "16 or 24", false,
+                            [](ManagerConfig& c, const Values& v) -> std::string {
+                              int depth = 0;
+                              if (!parse_integer(v.front(), 16, 24, depth) || (depth != 16 && depth != 24)) {
+                                return "expected 16 or 24";
+                              }
+                              c.x11.depth = depth;
+                              return "";
+                            },
+                            [](const ManagerConfig& c) -> Shown { return Values{std::to_string(c.x11.depth)}; }};
+
+  const ValueKind x11_xvnc{"PATH", "", false,
+                           [](ManagerConfig& c, const Values& v) -> std::string {
+                             if (v.front().empty() || v.front().front() != '/') {
+                               return "expected the absolute path of TigerVNC's Xvnc";
+                             }
+                             c.x11.xvnc = v.front();
+                             return "";
+                           },
+                           [](const ManagerConfig& c) -> Shown { return Values{c.x11.xvnc}; }};
+
+  // 0 stands for "the port of this host's cluster_peers entry", which the file does not write.
+  ValueKind registry_port = integer(&ManagerConfig::registry_port, 1, 65535);
+  registry_port.show = [show = registry_port.show](const ManagerConfig& c) -> Shown {
+    return c.registry_port == 0 ? std::nullopt : show(c);
   };
-}
 
-Apply text(std::string ManagerConfig::*field, std::size_t min_length = 1) {
-  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-    if (v.front().size() < min_length) {
-      return min_length <= 1 ? "must not be empty" : "must be at least " + std::to_string(min_length) + " characters";
-    }
-    c.*field = v.front();
-    return "";
+  const auto origin_problem = [](const std::string& origin) -> std::string {
+    if (contract::is_browser_origin(origin)) return "";
+    return "'" + origin + "' is not an origin such as https://survey.example.org (lower case, no path)";
   };
-}
 
-// A file of the ros section, made absolute (a session runs in its own folder) and checked by `problem`.
-Apply ros_file(std::string RosSettings::*field, std::string (*problem)(const std::string& path)) {
-  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-    if (v.front().empty()) return "must not be empty";
-    std::error_code ec;
-    const std::string path = std::filesystem::absolute(v.front(), ec).string();
-    if (ec) return "cannot make " + v.front() + " absolute: " + ec.message();
-    if (std::string found = problem(path); !found.empty()) return found;
-    c.ros.*field = path;
-    return "";
+  return {
+      row("listen_address", ipv4_address(&ManagerConfig::listen_address),
+          "numeric IPv4 address to listen on; `0.0.0.0` for every interface"),
+      row("port", integer(&ManagerConfig::port, 0, 65535), "the one public port (0 = any free port, printed at start)"),
+      row("tls_certificate", text(&ManagerConfig::tls_certificate, "PEM"),
+          "PEM certificate chain; with `tls_private_key` the port speaks HTTPS and WSS only"),
+      row("tls_private_key", text(&ManagerConfig::tls_private_key, "PEM"), "PEM private key of `tls_certificate`"),
+      row("session_command", text(&ManagerConfig::session_command, "PROGRAM"),
+          "the program started per session; `sim_rfb` means the one built or installed"),
+      row("session_kind",
+          enum_choice(&ManagerConfig::session_kind, {{"sim_rfb", SessionKind::kSimRfb},
+                                                     {"rfb", SessionKind::kRfb},
+                                                     {"x11", SessionKind::kX11}}),
+          "`sim_rfb`; `rfb` for any program that serves raw RFB on the port it is told as `{port}` (one linking "
+          "librfbsim); `x11` for any unmodified X11 program, each session on its own Xvnc display "
+          "(docs/other-simulators.md)"),
+      row("session_args", session_args,
+          "extra arguments for the session program (one `--session-arg ARG` flag each); for `rfb` and `x11`, the "
+          "program's whole argument list with placeholders"),
+      row("codec", choice(&ManagerConfig::codec, {"auto", "jpeg", "h264"}),
+          "sim_rfb's picture encoding: `auto` (Tight JPEG, H.264 for a browser that offers it once its link needs "
+          "it), `jpeg`, or `h264` (see \"Picture encoding\")"),
+      row("session_socket", choice(&ManagerConfig::session_socket, {"unix", "tcp"}),
+          "how the relay reaches sim_rfb: a private unix socket, or `tcp` (a loopback port any local user could "
+          "open)"),
+      row("log_level", choice(&ManagerConfig::log_level, Values(std::begin(rfbsim::log::kLevelNames), std::end(rfbsim::log::kLevelNames))),
+          "the manager's log (lines a client can cause, such as a refused connection, are rate-limited: past 5 of "
+          "a kind in 10 s one \"N more like this suppressed\" line says how many were left out)"),
+      row("max_sessions", integer(&ManagerConfig::max_sessions, 1, 10000),
+          "live sessions at once; the next participant is told to wait"),
+      row("max_duration_s", max_duration,
+          "a session ends this long after `/start` (SEAN-EP: 5 min); unset, it grows to what the offered "
+          "scenarios' tasks need (see \"Scenarios and session length\")",
+          "`300`, or what the tasks need"),
+      row("idle_timeout_s", seconds(&ManagerConfig::idle_timeout, 1),
+          "a session ends after this long with no browser connected"),
+      row("first_connect_timeout_s", seconds(&ManagerConfig::first_connect_timeout, 1),
+          "a session no browser ever connected to ends this long after `/start` (a link preview's session must not "
+          "hold a slot for the whole idle timeout)"),
+      row("start_timeout_s", seconds(&ManagerConfig::start_timeout, 1), "a session not ready by then has failed"),
+      row("stop_grace_s", seconds(&ManagerConfig::stop_grace, 0), "SIGTERM, then SIGKILL this long after"),
+      row("data_dir", text(&ManagerConfig::data_dir, "DIR"),
+          "`sessions.db` (the index) and `sessions/<id>-<uid>/` per session"),
+      row("scenarios", scenarios,
+          "scenarios links may name, the first the default; an entry `NAME=FILE` serves your own scenario file as "
+          "NAME (a relative FILE is taken from the manager's working directory); without any (the default of "
+          "`rfb` and `x11`) links need only `uid` and `{scenario}` is empty",
+          "`rfb`, `x11`: none"),
+      row("frame_origins", checked_list(&ManagerConfig::frame_origins, "O1,O2", origin_problem),
+          "origins allowed to frame the page and open its WebSocket, e.g. `https://yourschool.qualtrics.com`"),
+      secret_row("admin_token", secret(&ManagerConfig::admin_token),
+                 "turns on `/admin` and `/api/sessions` (or `RFBSIM_ADMIN_TOKEN`)"),
+      secret_row("link_secret", secret(&ManagerConfig::link_secret),
+                 "`/start` links must carry a valid `sig` (or `RFBSIM_LINK_SECRET`)"),
+      row("require_link_expiry", boolean(&ManagerConfig::require_link_expiry),
+          "with `link_secret`: links must carry a signed `exp` (a Unix time, seconds), and expire then"),
+      row("allow_repeat", boolean(&ManagerConfig::allow_repeat), "a uid whose session ended may start another"),
+      row("host_id",
+          checked_text(&ManagerConfig::host_id, "ID", "",
+                       [](const std::string& value) -> std::string {
+                         return is_identifier(value) ? "" : "expected letters, digits, - and _ (at most 64)";
+                       }),
+          "this host's name, recorded with every session in the index", "the host name"),
+      row("web_root", text(&ManagerConfig::web_root, "DIR"), "the participant page", "built or installed"),
+      row("public_url",
+          checked_text(&ManagerConfig::public_url, "ORIGIN", "",
+                       [](const std::string& value) -> std::string {
+                         if (contract::is_browser_origin(value)) return "";
+                         return "expected an origin such as https://h1.study.example.org (no path)";
+                       }),
+          "this host's public origin; `/start` redirects there (see \"Several hosts\")"),
+      row("path_prefix",
+          checked_text(&ManagerConfig::path_prefix, "/ID", "",
+                       [](const std::string& value) -> std::string {
+                         return is_path_prefix(value) ? "" : "expected / and 1-32 of a-z, 0-9 and - (e.g. /h2)";
+                       }),
+          "this host's part of a balancer's URL space, `/` and 1-32 of `a-z 0-9 -`: pages, sockets and the admin "
+          "API answer under it (see \"Path prefix, drain and agent-check\")",
+          "none (`/HOST_ID` with `cluster_peers`)"),
+      row("agent_port", integer(&ManagerConfig::agent_port, 0, 65535),
+          "HAProxy agent-check port: each connection reads `up ready NN%` or `drain` (0 = off)"),
+      row("agent_bind", ipv4_address(&ManagerConfig::agent_bind), "the agent port's numeric IPv4 address",
+          "`listen_address`"),
+      row("limit_address_space_mb", address_space,
+          "RLIMIT_AS per session process; an X11 program such as a Unity build reserves far more address "
+          "space than it uses",
+          "`8192` (`x11`: `65536`)"),
+      row("limit_open_files", limit_count(&ProcessLimits::open_files, kMaxOpenFiles, "N", "a count"),
+          "RLIMIT_NOFILE per session"),
+      row("limit_cpu_time_factor", cpu_factor,
+          "RLIMIT_CPU = max_duration × this + slack + grace: about how many cores a session may use on "
+          "average"),
+      row("limit_cpu_slack_s", cpu_slack, "added to the CPU limit"),
+      row("rate_start_per_minute", abuse_count(&AbuseLimits::start_per_minute),
+          "`/start` requests per client address per minute, sustained (429 + `Retry-After` beyond)"),
+      row("rate_start_burst", abuse_count(&AbuseLimits::start_burst), "`/start` requests per client address at once"),
+      row("rate_upgrade_per_minute", abuse_count(&AbuseLimits::upgrade_per_minute),
+          "WebSocket upgrades per client address per minute, sustained (reconnects)"),
+      row("rate_upgrade_burst", abuse_count(&AbuseLimits::upgrade_burst),
+          "WebSocket upgrades per client address at once"),
+      row("max_connections_per_address", abuse_count(&AbuseLimits::connections_per_address),
+          "open connections per client address; more are closed at accept"),
+      row("max_connections", abuse_count(&AbuseLimits::connections_total),
+          "open connections in all (0 = the descriptor limit minus what sessions need)"),
+      row("max_unspent_sessions_per_address", abuse_count(&AbuseLimits::unspent_sessions_per_address),
+          "live sessions one address started that no participant has seen yet"),
+      row("ws_ping_interval_s", abuse_seconds(&AbuseLimits::ws_ping_interval), "a ping to every WebSocket this often"),
+      row("ws_pong_timeout_s", abuse_seconds(&AbuseLimits::ws_pong_timeout),
+          "a WebSocket whose pong is this late is closed"),
+      row("trusted_proxies",
+          checked_list(&ManagerConfig::trusted_proxies, "A,B",
+                       [](const std::string& entry) -> std::string {
+                         if (parse_address_range(entry)) return "";
+                         return "'" + entry + "' is not an address or CIDR range such as 10.0.0.0/8";
+                       }),
+          "front ends whose `X-Forwarded-For` names the participant (addresses or CIDR ranges)"),
+      row("on_data_incomplete",
+          enum_choice(&ManagerConfig::on_data_incomplete,
+                      {{"continue", DataFailurePolicy::kContinue}, {"end", DataFailurePolicy::kEnd}}),
+          "when a session's data cannot be written (a full disk): `continue` (the participant carries on; the "
+          "index marks the session `data_incomplete`) or `end` (the session ends and the page says so)"),
+      row("after_session_command", after_session_command,
+          "the command that copies each ended session's folder off this host: an argument list, no shell, with "
+          "`{folder}` `{folder_name}` `{uid}` `{host}` `{session_id}` (one `--after-session-command ARG` flag per "
+          "argument; see \"Copying each session off the host\")"),
+      row("after_session_retries", integer(&ManagerConfig::after_session_retries, 0, 100),
+          "tries after a failed first one, 5 s apart and then doubling up to 5 min"),
+      row("after_session_timeout_s", seconds(&ManagerConfig::after_session_timeout, 1),
+          "one try's limit; then SIGTERM to the command's process group, SIGKILL after `stop_grace_s`"),
+      row("cluster_peers", cluster_peers(),
+          "every host's uid registry as `ID=ADDRESS:PORT`, this one included: a uid gets one session in the whole cluster (needs "
+          "`host_id`; the same entries on every host, an odd number of them; see \"Several hosts\")"),
+      row("cluster_secret_file", text(&ManagerConfig::cluster_secret_file, "FILE"),
+          "the hosts' shared registry secret, 16 bytes or more (mode 0600)"),
+      row("registry_port", registry_port, "this host's registry port", "its `cluster_peers` entry's"),
+      row("registry_bind", ipv4_address(&ManagerConfig::registry_bind), "the registry's numeric IPv4 address",
+          "`listen_address`"),
+      row("ros_connect", ros_text(&RosSettings::connect, "URL", rosbridge_url_problem),
+          "a lab's rosbridge_server, `ws://` or `wss://`: each session of a scenario with a robot dials out to it "
+          "(see \"ROS\")",
+          "none: no ROS"),
+      row("ros_token_file", ros_file(&RosSettings::token_file, token_file_problem),
+          "a Bearer token for that dial-out (one line)"),
+      row("ros_ca_file", ros_file(&RosSettings::ca_file, ca_file_problem),
+          "extra PEM CA certificates for a `wss://` dial-out", "the system's only"),
+      row("ros_namespace",
+          ros_text(&RosSettings::ros_namespace, "NS",
+                   [](const std::string& value) -> std::string {
+                     if (is_ros_name(value)) return "";
+                     return "expected a ROS name such as /rfbsim: '/', then segments of letters, digits and '_' that "
+                            "start with a letter, joined by '/', no '/' at the end";
+                   }),
+          "each session's topics go under `<namespace>/s_<id>`"),
+      row("ros_robot_control", ros_choice(&RosSettings::robot_control, {"builtin", "external"}),
+          "who drives the robot where a link does not say", "the scenario's `robot.control`"),
+      row("ros_cmd_vel_type", ros_choice(&RosSettings::cmd_vel_type, {"twist", "twist_stamped"}),
+          "the type of the lab's `/cmd_vel`"),
+      row("x11_geometry", x11_geometry, "`x11` only: the display's, and so the picture's, size"),
+      row("x11_depth", x11_depth, "`x11` only: the display's bits per pixel"),
+      row("x11_xvnc", x11_xvnc, "`x11` only: TigerVNC's Xvnc (Debian: tigervnc-standalone-server)"),
   };
-}
-
-Apply boolean(bool ManagerConfig::*field) {
-  return [=](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-    if (v.front() == "true" || v.front() == "yes" || v.front() == "1") {
-      c.*field = true;
-    } else if (v.front() == "false" || v.front() == "no" || v.front() == "0") {
-      c.*field = false;
-    } else {
-      return "expected true or false";
-    }
-    return "";
-  };
-}
-
-// An origin as browsers send it, scheme://host[:port] and nothing after: frame origins are compared with the
-// Origin header byte for byte (the contract's rule, of the same shape as sim_rfb's --allow-origin).
-bool is_origin(const std::string& origin) { return contract::is_browser_origin(origin); }
-
-// A host name as DNS compares it: ASCII letters without case.
-std::string lower_case(std::string text) {
-  for (char& ch : text) {
-    if (ch >= 'A' && ch <= 'Z') ch = static_cast<char>(ch - 'A' + 'a');
-  }
-  return text;
-}
-
-// "ID=ADDRESS:PORT", one entry of cluster_peers.
-std::optional<ClusterPeer> parse_cluster_peer(const std::string& entry) {
-  const std::size_t eq = entry.find('=');
-  const std::size_t colon = entry.rfind(':');
-  if (eq == std::string::npos || colon == std::string::npos || colon < eq) return std::nullopt;
-  ClusterPeer peer;
-  peer.id = entry.substr(0, eq);
-  peer.address = entry.substr(eq + 1, colon - eq - 1);
-  if (!is_host_id(peer.id) || !parse_integer(entry.substr(colon + 1), 1, 65535, peer.port)) return std::nullopt;
-  // A host name or a numeric IPv4 address: letters, digits, dots and dashes.
-  if (peer.address.empty() || peer.address.size() > 253) return std::nullopt;
-  for (const char ch : peer.address) {
-    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '.' ||
-                    ch == '-';
-    if (!ok) return std::nullopt;
-  }
-  return peer;
 }
 
 }  // namespace
 
-const std::map<std::string, Setting>& settings() {
-  static const std::map<std::string, Setting> table = {
-      {"listen_address", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         in_addr address{};
-         if (::inet_pton(AF_INET, v.front().c_str(), &address) != 1) return "expected a numeric IPv4 address";
-         c.listen_address = v.front();
-         return "";
-       }}},
-      {"port", {false, integer(&ManagerConfig::port, 0, 65535)}},
-      {"tls_certificate", {false, text(&ManagerConfig::tls_certificate)}},
-      {"tls_private_key", {false, text(&ManagerConfig::tls_private_key)}},
-      {"session_command", {false, text(&ManagerConfig::session_command)}},
-      {"session_kind", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.front() == "sim_rfb") {
-           c.session_kind = SessionKind::kSimRfb;
-         } else if (v.front() == "rfb") {
-           c.session_kind = SessionKind::kRfb;
-         } else if (v.front() == "x11") {
-           c.session_kind = SessionKind::kX11;
-         } else {
-           return "expected sim_rfb, rfb or x11";
-         }
-         return "";
-       }}},
-      {"session_args", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         c.session_args = v;
-         return "";
-       }}},
-      {"codec", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.front() != "auto" && v.front() != "jpeg" && v.front() != "h264") return "expected auto, jpeg or h264";
-         c.codec = v.front();
-         return "";
-       }}},
-      {"log_level", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         rfbsim::log::Level level{};
-         if (!rfbsim::log::parse_level(v.front(), level)) return "expected error, warn, info or debug";
-         c.log_level = v.front();
-         return "";
-       }}},
-      {"session_socket", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.front() != "unix" && v.front() != "tcp") return "expected unix or tcp";
-         c.session_socket = v.front();
-         return "";
-       }}},
-      {"max_sessions", {false, integer(&ManagerConfig::max_sessions, 1, 10000)}},
-      {"max_duration_s", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         c.max_duration_set = true;  // the researcher's own limit: fit_max_duration keeps it
-         return seconds(&ManagerConfig::max_duration, 1)(c, v);
-       }}},
-      {"idle_timeout_s", {false, seconds(&ManagerConfig::idle_timeout, 1)}},
-      {"first_connect_timeout_s", {false, seconds(&ManagerConfig::first_connect_timeout, 1)}},
-      {"start_timeout_s", {false, seconds(&ManagerConfig::start_timeout, 1)}},
-      {"stop_grace_s", {false, seconds(&ManagerConfig::stop_grace, 0)}},
-      {"data_dir", {false, text(&ManagerConfig::data_dir)}},
-      {"scenarios", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.empty()) return "list at least one scenario";
-         for (const std::string& entry : v) {
-           const std::string name = entry.substr(0, entry.find('='));
-           if (!is_identifier(name)) {
-             return "'" + entry + "' is not a scenario name (letters, digits, - and _, at most 64), optionally =FILE";
-           }
-         }
-         c.scenarios = v;
-         c.scenarios_set = true;
-         return "";
-       }}},
-      {"frame_origins", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         for (const std::string& origin : v) {
-           if (!is_origin(origin)) {
-             return "'" + origin + "' is not an origin such as https://survey.example.org (lower case, no path)";
-           }
-         }
-         c.frame_origins = v;
-         return "";
-       }}},
-      {"admin_token", {false, text(&ManagerConfig::admin_token, 16)}},
-      {"link_secret", {false, text(&ManagerConfig::link_secret, 16)}},
-      {"allow_repeat", {false, boolean(&ManagerConfig::allow_repeat)}},
-      {"require_link_expiry", {false, boolean(&ManagerConfig::require_link_expiry)}},
-      {"host_id", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (!is_identifier(v.front())) return "expected letters, digits, - and _ (at most 64)";
-         c.host_id = v.front();
-         return "";
-       }}},
-      {"web_root", {false, text(&ManagerConfig::web_root)}},
-      {"public_url", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (!is_origin(v.front())) return "expected an origin such as https://h1.study.example.org (no path)";
-         c.public_url = v.front();
-         return "";
-       }}},
-      {"path_prefix", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (!is_path_prefix(v.front())) return "expected / and 1-32 of a-z, 0-9 and - (e.g. /h2)";
-         c.path_prefix = v.front();
-         return "";
-       }}},
-      {"agent_port", {false, integer(&ManagerConfig::agent_port, 0, 65535)}},
-      {"agent_bind", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         in_addr address{};
-         if (::inet_pton(AF_INET, v.front().c_str(), &address) != 1) return "expected a numeric IPv4 address";
-         c.agent_bind = v.front();
-         return "";
-       }}},
-      {"limit_address_space_mb", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (!parse_integer<std::uint64_t>(v.front(), 0, 1ULL << 30, c.limits.address_space_mb)) {
-           return "expected MiB, 0 = no limit";
-         }
-         c.limits.address_space_set = true;
-         return "";
-       }}},
-      {"limit_open_files", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (!parse_integer<std::uint64_t>(v.front(), 0, 1ULL << 20, c.limits.open_files)) {
-           return "expected a count, 0 = no limit";
-         }
-         return "";
-       }}},
-      {"limit_cpu_time_factor", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         double factor = 0;
-         const char* end = v.front().data() + v.front().size();
-         const auto [ptr, ec] = std::from_chars(v.front().data(), end, factor);
-         if (v.front().empty() || ec != std::errc() || ptr != end || !std::isfinite(factor) || factor < 0 ||
-             factor > 256) {
-           return "expected cores per session 0..256, 0 = no CPU limit";
-         }
-         c.limits.cpu_time_factor = factor;
-         return "";
-       }}},
-      {"rate_start_per_minute", {false, abuse_integer(&AbuseLimits::start_per_minute, 1000000)}},
-      {"rate_start_burst", {false, abuse_integer(&AbuseLimits::start_burst, 1000000)}},
-      {"rate_upgrade_per_minute", {false, abuse_integer(&AbuseLimits::upgrade_per_minute, 1000000)}},
-      {"rate_upgrade_burst", {false, abuse_integer(&AbuseLimits::upgrade_burst, 1000000)}},
-      {"max_connections_per_address", {false, abuse_integer(&AbuseLimits::connections_per_address, 1000000)}},
-      {"max_connections", {false, abuse_integer(&AbuseLimits::connections_total, 1000000)}},
-      {"max_unspent_sessions_per_address", {false, abuse_integer(&AbuseLimits::unspent_sessions_per_address, 1000000)}},
-      {"ws_ping_interval_s", {false, abuse_seconds(&AbuseLimits::ws_ping_interval)}},
-      {"ws_pong_timeout_s", {false, abuse_seconds(&AbuseLimits::ws_pong_timeout)}},
-      {"trusted_proxies", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         for (const std::string& entry : v) {
-           if (!parse_address_range(entry)) return "'" + entry + "' is not an address or CIDR range such as 10.0.0.0/8";
-         }
-         c.trusted_proxies = v;
-         return "";
-       }}},
-      {"on_data_incomplete", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.front() == "continue") {
-           c.on_data_incomplete = DataFailurePolicy::kContinue;
-         } else if (v.front() == "end") {
-           c.on_data_incomplete = DataFailurePolicy::kEnd;
-         } else {
-           return "expected continue or end";
-         }
-         return "";
-       }}},
-      {"cluster_peers", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         std::vector<ClusterPeer> peers;
-         for (const std::string& entry : v) {
-           const auto peer = parse_cluster_peer(entry);
-           if (!peer) return "'" + entry + "' is not ID=ADDRESS:PORT (ID: 1-32 of a-z 0-9 -, PORT: 1..65535)";
-           for (const ClusterPeer& other : peers) {
-             if (other.id == peer->id) return "host id '" + peer->id + "' is listed twice";
-             // Two ids at one registry would be one acceptor voting twice: majorities would no longer intersect.
-             if (other.port == peer->port && lower_case(other.address) == lower_case(peer->address)) {
-               return "hosts '" + other.id + "' and '" + peer->id + "' have the same registry " + peer->address + ":" +
-                      std::to_string(peer->port);
-             }
-           }
-           peers.push_back(*peer);
-         }
-         c.cluster_peers = std::move(peers);
-         return "";
-       }}},
-      {"cluster_secret_file", {false, text(&ManagerConfig::cluster_secret_file)}},
-      {"registry_port", {false, integer(&ManagerConfig::registry_port, 1, 65535)}},
-      {"registry_bind", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         in_addr address{};
-         if (::inet_pton(AF_INET, v.front().c_str(), &address) != 1) return "expected a numeric IPv4 address";
-         c.registry_bind = v.front();
-         return "";
-       }}},
-      {"after_session_command", {true, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (std::string problem = copy_command_problem(v); !problem.empty()) return problem;
-         c.after_session_command = v;
-         return "";
-       }}},
-      {"after_session_retries", {false, integer(&ManagerConfig::after_session_retries, 0, 100)}},
-      {"after_session_timeout_s", {false, seconds(&ManagerConfig::after_session_timeout, 1)}},
-      // The ros: section, each key as ros_<key> (--ros-<key> on the command line); files made absolute, since a
-      // session runs in its own folder.
-      {"ros_connect", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (std::string problem = rosbridge_url_problem(v.front()); !problem.empty()) return problem;
-         c.ros.connect = v.front();
-         return "";
-       }}},
-      {"ros_token_file", {false, ros_file(&RosSettings::token_file, token_file_problem)}},
-      {"ros_ca_file", {false, ros_file(&RosSettings::ca_file, ca_file_problem)}},
-      {"ros_namespace", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (!is_ros_name(v.front())) {
-           return "expected a ROS name such as /rfbsim: '/', then segments of letters, digits and '_' that start "
-                  "with a letter, joined by '/', no '/' at the end";
-         }
-         c.ros.ros_namespace = v.front();
-         return "";
-       }}},
-      {"ros_robot_control", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.front() != "builtin" && v.front() != "external") return "expected builtin or external";
-         c.ros.robot_control = v.front();
-         return "";
-       }}},
-      {"ros_cmd_vel_type", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.front() != "twist" && v.front() != "twist_stamped") return "expected twist or twist_stamped";
-         c.ros.cmd_vel_type = v.front();
-         return "";
-       }}},
-      {"limit_cpu_slack_s", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         long long value = 0;
-         if (!parse_integer(v.front(), 0LL, kMaxCpuSlackS, value)) {
-           return "expected whole seconds 0.." + std::to_string(kMaxCpuSlackS);
-         }
-         c.limits.cpu_slack = std::chrono::seconds(value);
-         return "";
-       }}},
-      // The x11 section (x11: {geometry, depth, xvnc}): the display each x11 session's program runs on.
-      {"x11_geometry", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         const std::string& text = v.front();
-         const std::size_t x = text.find('x');
-         int width = 0;
-         int height = 0;
-         // Xvnc needs whole pixels; a screen past 8192 would cost a participant's link more than any program.
-         if (x == std::string::npos || !parse_integer(text.substr(0, x), 64, 8192, width) ||
-             !parse_integer(text.substr(x + 1), 64, 8192, height)) {
-           return "expected WIDTHxHEIGHT, each 64..8192 (e.g. 1280x720)";
-         }
-         c.x11.width = width;
-         c.x11.height = height;
-         return "";
-       }}},
-      {"x11_depth", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         int depth = 0;
-         if (!parse_integer(v.front(), 16, 24, depth) || (depth != 16 && depth != 24)) return "expected 16 or 24";
-         c.x11.depth = depth;
-         return "";
-       }}},
-      {"x11_xvnc", {false, [](ManagerConfig& c, const std::vector<std::string>& v) -> std::string {
-         if (v.front().empty() || v.front().front() != '/') return "expected the absolute path of TigerVNC's Xvnc";
-         c.x11.xvnc = v.front();
-         return "";
-       }}},
-  };
+const std::vector<Setting>& settings() {
+  static const std::vector<Setting> table = build_table();
   return table;
 }
 
-std::string flag_to_key(const std::string& flag) {
-  std::string key = flag.substr(2);
-  for (char& ch : key) {
-    if (ch == '-') ch = '_';
+const Setting* find_setting(const std::string& key) {
+  for (const Setting& setting : settings()) {
+    if (setting.key == key) return &setting;
+  }
+  return nullptr;
+}
+
+std::string flag_of(const std::string& key) {
+  std::string flag = "--" + key;
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  return flag;
+}
+
+std::string file_name_of(const std::string& key) {
+  for (const std::string& section : kSections) {
+    if (key.rfind(section + "_", 0) == 0) return section + "." + key.substr(section.size() + 1);
   }
   return key;
 }

@@ -13,9 +13,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "rfbsim/log.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <functional>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -48,7 +51,32 @@ class Formatter : public CLI::Formatter {
     if (!option->get_default_str().empty()) {
       notes += (notes.empty() ? "" : "; ") + std::string("default ") + option->get_default_str();
     }
-    return option->get_description() + (notes.empty() ? "" : " (" + notes + ")");
+    return wrap(option->get_description() + (notes.empty() ? "" : " (" + notes + ")"));
+  }
+
+ private:
+  // The help's lines end by column 110: CLI11 indents each line of a description after a '\n' to its column.
+  std::string wrap(const std::string& text) const {
+    const std::size_t width = 110 > get_column_width() + 30 ? 110 - get_column_width() : 30;
+    std::string wrapped;
+    std::size_t line_length = 0;
+    std::size_t start = 0;
+    while (start < text.size()) {
+      std::size_t end = text.find(' ', start);
+      if (end == std::string::npos) end = text.size();
+      const std::size_t word = end - start;
+      if (line_length > 0 && line_length + 1 + word > width) {
+        wrapped += '\n';
+        line_length = 0;
+      } else if (line_length > 0) {
+        wrapped += ' ';
+        ++line_length;
+      }
+      wrapped += text.substr(start, word);
+      line_length += word;
+      start = end + 1;
+    }
+    return wrapped;
   }
 };
 
@@ -146,7 +174,7 @@ inline std::string option_named_in(CLI::App& app, const std::string& message, co
 /// which the program hands to rfbsim::log::parse_level once parsing is done.
 inline CLI::Option* add_log_level(CLI::App& app, std::string& level) {
   return one_of(app.add_option("--log-level", level, "the log's level")->type_name("L")->capture_default_str(),
-                {"error", "warn", "info", "debug"});
+                std::vector<std::string>(std::begin(rfbsim::log::kLevelNames), std::end(rfbsim::log::kLevelNames)));
 }
 
 /// Parses `args` (argv without the program name) into the variables `app`'s options are bound to. Returns "" on

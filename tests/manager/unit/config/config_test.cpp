@@ -370,18 +370,18 @@ TEST_CASE("the --help and --sign flags") {
   CHECK_FALSE(sign.help);
   CHECK(sign.sign_query == "uid=p01&scenario=lab");
   CHECK(sign.config.link_secret == "0123456789abcdef");
-  CHECK_THAT(manager_usage(), StartsWith("usage: sim_manager [--config FILE]"));
+  CHECK_THAT(manager_usage(), StartsWith("usage: sim_manager"));
   CHECK_THAT(manager_usage(), Contains("--sign QUERY"));
 }
 
 TEST_CASE("bad command lines say what is wrong") {
-  CHECK(args_error({"--bogus", "1"}) == "unknown option '--bogus'");
-  CHECK(args_error({"--session-args", "x"}) == "unknown option '--session-args'");
-  CHECK(args_error({"--session_args", "x"}) == "unknown option '--session_args'");
-  CHECK(args_error({"serve"}) == "unexpected argument 'serve'");
-  CHECK(args_error({"-p", "80"}) == "unexpected argument '-p'");
+  CHECK(args_error({"--bogus", "1"}) == "unknown argument '--bogus'");
+  CHECK(args_error({"--session-args", "x"}) == "unknown argument '--session-args'");
+  CHECK(args_error({"--session_args", "x"}) == "unknown argument '--session_args'");
+  CHECK(args_error({"serve"}) == "unknown argument 'serve'");
+  CHECK(args_error({"-p", "80"}) == "unknown argument '-p'");
   CHECK(args_error({"--port"}) == "--port needs a value");
-  CHECK(args_error({"--config"}) == "--config needs a file");
+  CHECK(args_error({"--config"}) == "--config needs a value");
   CHECK(args_error({"--port", "70000"}) == "--port '70000': expected an integer 0..65535");
   CHECK(args_error({"--max-sessions", "0"}) == "--max-sessions '0': expected an integer 1..10000");
   CHECK(args_error({"--listen-address", "localhost"}) == "--listen-address 'localhost': expected a numeric IPv4 address");
@@ -575,7 +575,7 @@ TEST_CASE("a bad ros section says which key and why") {
   const std::string two_lines = dir.write("two.token", "secret-a\nsecret-b\n");
   CHECK(file_error(dir, "ros:\n  token_file: " + two_lines + "\n").find("secret-") == std::string::npos);
   CHECK(args_error({"--ros-robot-control", "maybe"}) == "--ros-robot-control 'maybe': expected builtin or external");
-  CHECK(args_error({"--ros-port", "9090"}) == "unknown option '--ros-port'");
+  CHECK(args_error({"--ros-port", "9090"}) == "unknown argument '--ros-port'");
 }
 
 TEST_CASE("ros settings that cannot work together") {

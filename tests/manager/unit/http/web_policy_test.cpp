@@ -12,7 +12,7 @@ using rfbsim::manager::websocket_origin_allowed;
 
 namespace {
 
-const std::string kToken = "0123456789abcdef";
+const std::string kPolicyToken = "0123456789abcdef";
 const std::vector<std::string> kFrameOrigins = {"https://a.example", "https://b.example"};
 
 }  // namespace
@@ -58,34 +58,34 @@ TEST_CASE("a WebSocket from any other origin is refused") {
 }
 
 TEST_CASE("the admin token is accepted as a Bearer token") {
-  CHECK(admin_authorized("Bearer " + kToken, kToken));
-  CHECK(admin_authorized("bearer " + kToken, kToken));
-  CHECK(admin_authorized("BEARER " + kToken, kToken));
-  CHECK_FALSE(admin_authorized("Bearer " + kToken + "x", kToken));
-  CHECK_FALSE(admin_authorized("Bearer " + kToken.substr(1), kToken));
-  CHECK_FALSE(admin_authorized("Bearer 0123456789ABCDEF", kToken));
-  CHECK_FALSE(admin_authorized("Bearer  " + kToken, kToken));
-  CHECK_FALSE(admin_authorized("Bearer", kToken));
-  CHECK_FALSE(admin_authorized(kToken, kToken));
-  CHECK_FALSE(admin_authorized("", kToken));
-  CHECK_FALSE(admin_authorized("Token " + kToken, kToken));
+  CHECK(admin_authorized("Bearer " + kPolicyToken, kPolicyToken));
+  CHECK(admin_authorized("bearer " + kPolicyToken, kPolicyToken));
+  CHECK(admin_authorized("BEARER " + kPolicyToken, kPolicyToken));
+  CHECK_FALSE(admin_authorized("Bearer " + kPolicyToken + "x", kPolicyToken));
+  CHECK_FALSE(admin_authorized("Bearer " + kPolicyToken.substr(1), kPolicyToken));
+  CHECK_FALSE(admin_authorized("Bearer 0123456789ABCDEF", kPolicyToken));
+  CHECK_FALSE(admin_authorized("Bearer  " + kPolicyToken, kPolicyToken));
+  CHECK_FALSE(admin_authorized("Bearer", kPolicyToken));
+  CHECK_FALSE(admin_authorized(kPolicyToken, kPolicyToken));
+  CHECK_FALSE(admin_authorized("", kPolicyToken));
+  CHECK_FALSE(admin_authorized("Token " + kPolicyToken, kPolicyToken));
 }
 
 TEST_CASE("the admin token is accepted as the password of HTTP Basic") {
   // base64("admin:0123456789abcdef"), base64(":0123456789abcdef"), base64("x:0123456789abcdef")
-  CHECK(admin_authorized("Basic YWRtaW46MDEyMzQ1Njc4OWFiY2RlZg==", kToken));
-  CHECK(admin_authorized("basic YWRtaW46MDEyMzQ1Njc4OWFiY2RlZg==", kToken));
-  CHECK(admin_authorized("Basic OjAxMjM0NTY3ODlhYmNkZWY=", kToken));
-  CHECK(admin_authorized("Basic eDowMTIzNDU2Nzg5YWJjZGVm", kToken));
+  CHECK(admin_authorized("Basic YWRtaW46MDEyMzQ1Njc4OWFiY2RlZg==", kPolicyToken));
+  CHECK(admin_authorized("basic YWRtaW46MDEyMzQ1Njc4OWFiY2RlZg==", kPolicyToken));
+  CHECK(admin_authorized("Basic OjAxMjM0NTY3ODlhYmNkZWY=", kPolicyToken));
+  CHECK(admin_authorized("Basic eDowMTIzNDU2Nzg5YWJjZGVm", kPolicyToken));
 }
 
 TEST_CASE("HTTP Basic with a wrong or malformed credential is refused") {
-  CHECK_FALSE(admin_authorized("Basic YWRtaW46MDEyMzQ1Njc4OWFiY2RlWA==", kToken));  // admin:0123456789abcdeX
-  CHECK_FALSE(admin_authorized("Basic YWRtaW4wMTIzNDU2Nzg5YWJjZGVm", kToken));      // no colon
-  CHECK_FALSE(admin_authorized("Basic !!!!", kToken));
-  CHECK_FALSE(admin_authorized("Basic YWRtaW46MDEyMzQ1Njc4OWFiY2RlZg=", kToken));   // not a multiple of 4
-  CHECK_FALSE(admin_authorized("Basic ", kToken));
-  CHECK_FALSE(admin_authorized("Basic", kToken));
+  CHECK_FALSE(admin_authorized("Basic YWRtaW46MDEyMzQ1Njc4OWFiY2RlWA==", kPolicyToken));  // admin:0123456789abcdeX
+  CHECK_FALSE(admin_authorized("Basic YWRtaW4wMTIzNDU2Nzg5YWJjZGVm", kPolicyToken));      // no colon
+  CHECK_FALSE(admin_authorized("Basic !!!!", kPolicyToken));
+  CHECK_FALSE(admin_authorized("Basic YWRtaW46MDEyMzQ1Njc4OWFiY2RlZg=", kPolicyToken));   // not a multiple of 4
+  CHECK_FALSE(admin_authorized("Basic ", kPolicyToken));
+  CHECK_FALSE(admin_authorized("Basic", kPolicyToken));
 }
 
 TEST_CASE("with no admin token configured nothing is authorized") {
