@@ -74,6 +74,8 @@ class Relay : public std::enable_shared_from_this<Relay<Server>> {
   [[nodiscard]] const std::string& token() const { return token_; }
   [[nodiscard]] RelayKind kind() const { return kind_; }
   [[nodiscard]] bool connecting_or_connected() const { return connect_started_; }
+  /// Whether close() or browser_gone() ran: the relay only waits for its browser's socket to finish closing.
+  [[nodiscard]] bool closed() const { return closed_; }
 
   /// What to call when the first picture has gone to the browser (participant relays only).
   void on_picture_delivered(PictureDelivered callback) { on_picture_delivered_ = std::move(callback); }

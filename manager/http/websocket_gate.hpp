@@ -273,10 +273,12 @@ class WebSocketGate {
   }
 
  private:
+  // Each newer browser takes over once, from the one live before it: a relay already told (and still waiting out
+  // its browser's close) is not told again, nor counted, so N upgrades cost N - 1 takeovers, not N(N-1)/2.
   void take_over_from_earlier(const Session& session) {
     auto relays = relays_;  // closing calls back into forget
     for (auto& [hdl, relay] : relays) {
-      if (relay->session_id() != session.id || relay->kind() != RelayKind::kParticipant) continue;
+      if (relay->session_id() != session.id || relay->kind() != RelayKind::kParticipant || relay->closed()) continue;
       metrics_.count_takeover();
       rfbsim::log::limited(rfbsim::log::Level::kInfo, "takeover", "manager",
                            "session %lld (uid %s): a newer browser took over; the earlier one is told",

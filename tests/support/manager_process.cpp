@@ -128,7 +128,7 @@ ManagerUnderTest::ManagerUnderTest(const std::filesystem::path& data_dir, const 
     : data_dir_(data_dir), options_(std::move(options)) {
   std::vector<std::string> args = {"--port", "0", "--data-dir", data_dir.string()};
   args.insert(args.end(), flags.begin(), flags.end());
-  process_ = std::make_unique<SimProcess>(options_.program, args);
+  process_ = std::make_unique<SimProcess>(options_.program, args, std::chrono::seconds(30), options_.log_file.string());
 }
 
 ManagerUnderTest::~ManagerUnderTest() {

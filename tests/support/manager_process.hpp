@@ -69,6 +69,8 @@ struct ManagerOptions {
   int stop_signal = SIGKILL;
   std::chrono::milliseconds stop_timeout = std::chrono::seconds(5);  ///< wait for the exit on destruction
   std::chrono::milliseconds poll_interval = std::chrono::milliseconds(20);  ///< between looks in wait_for_*
+  /// Where the manager's log (its stderr) is appended; empty = the test's own stderr.
+  std::filesystem::path log_file;
 };
 
 class ManagerUnderTest {

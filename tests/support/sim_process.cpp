@@ -27,15 +27,20 @@ std::string sim_rfb_path() {
 
 namespace {
 
-// A child running `program` with `args` (no shell); its stdout, and stderr too when asked, go to a pipe.
+// A child running `program` with `args` (no shell); its stdout, and stderr too when asked, go to a pipe; else its
+// stderr is appended to `stderr_path` where one is given.
 struct Spawned {
   pid_t pid = -1;
   int output_fd = -1;  // the pipe's read end, owned by the caller
 };
 
-Spawned spawn(const std::string& program, const std::vector<std::string>& args, bool with_stderr) {
+Spawned spawn(const std::string& program, const std::vector<std::string>& args, bool with_stderr,
+              const std::string& stderr_path = {}) {
   int pipe_fds[2];
   if (::pipe2(pipe_fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  const int stderr_fd =
+      stderr_path.empty() ? -1 : ::open(stderr_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600);
+  if (!stderr_path.empty() && stderr_fd < 0) throw std::runtime_error("cannot open " + stderr_path);
   std::vector<std::string> argv_strings{program};
   argv_strings.insert(argv_strings.end(), args.begin(), args.end());
   std::vector<char*> argv;
@@ -49,10 +54,12 @@ Spawned spawn(const std::string& program, const std::vector<std::string>& args, 
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     ::dup2(pipe_fds[1], STDOUT_FILENO);
     if (with_stderr) ::dup2(pipe_fds[1], STDERR_FILENO);
+    if (stderr_fd >= 0) ::dup2(stderr_fd, STDERR_FILENO);
     ::execv(program.c_str(), argv.data());
     _exit(127);
   }
   ::close(pipe_fds[1]);
+  if (stderr_fd >= 0) ::close(stderr_fd);
   return {pid, pipe_fds[0]};
 }
 
@@ -86,8 +93,8 @@ ExitResult run_to_exit(const std::string& program, const std::vector<std::string
 }
 
 SimProcess::SimProcess(const std::string& program, const std::vector<std::string>& args,
-                       std::chrono::milliseconds timeout) {
-  const Spawned child = spawn(program, args, false);
+                       std::chrono::milliseconds timeout, const std::string& stderr_path) {
+  const Spawned child = spawn(program, args, false, stderr_path);
   pid_ = child.pid;
   stdout_fd_ = child.output_fd;
 

@@ -14,8 +14,10 @@ class SimProcess {
  public:
   /// Starts `program` with `args` (no shell), and waits for its "ready: URL" line (http or https) on stdout.
   /// Throws std::runtime_error if it exits or stays silent past `timeout`.
+  /// With `stderr_path`, the process's stderr is appended to that file (a test that reads the log); else it is
+  /// this process's.
   SimProcess(const std::string& program, const std::vector<std::string>& args,
-             std::chrono::milliseconds timeout = std::chrono::seconds(30));
+             std::chrono::milliseconds timeout = std::chrono::seconds(30), const std::string& stderr_path = {});
   /// Sends SIGKILL if the process still runs, and reaps it.
   ~SimProcess();
   SimProcess(const SimProcess&) = delete;
