@@ -38,7 +38,7 @@ std::string round_trip(const Strings& args, const Environment& environment = {})
 
 }  // namespace
 
-TEST_CASE("--print-config of the defaults reads back as the defaults") {
+TEST_CASE("the printed config of the defaults reads back as the defaults") {
   const std::string text = round_trip({});
   CHECK_THAT(text, Contains("\nport: 8080\n"));
   CHECK_THAT(text, Contains("\nscenarios:\n  - warehouse\n  - lab\n"));
@@ -58,7 +58,7 @@ TEST_CASE("--print-config of the defaults reads back as the defaults") {
   }
 }
 
-TEST_CASE("--print-config merges the file, the flags and the environment, and its print reads back the same") {
+TEST_CASE("the printed config merges the file, the flags and the environment, and reads back the same") {
   ScratchDir dir;
   const std::string file = dir.write("manager.yaml", R"(port: 9090
 session_kind: rfb
@@ -104,7 +104,7 @@ TEST_CASE("a printed config's secret placeholder must be filled before sim_manag
         "RFBSIM_LINK_SECRET: must be the secret itself, not <set>");
 }
 
-TEST_CASE("--print-config keeps what session_kind and cluster_peers settle") {
+TEST_CASE("the printed config keeps what session_kind and cluster_peers settle") {
   // rfb offers no scenarios unless told: the print leaves them unset, not an empty list it could not read.
   const std::string rfb = round_trip({"--session-kind", "rfb", "--session-arg", "{port}"});
   CHECK_THAT(rfb, Contains("\n# scenarios: (unset: rfb, x11: none)\n"));
