@@ -178,8 +178,16 @@ int run(ManagerConfig config) {
   boost::asio::io_context io;
   manager::Metrics metrics;
   manager::Supervisor supervisor(io, config, program, index, metrics);
-  if (const int interrupted = supervisor.recover_interrupted(); interrupted > 0) {
-    rfbsim::log::info("manager", "marked %d session(s) left by the previous run as interrupted", interrupted);
+  if (const auto recovery = supervisor.recover_interrupted(); !recovery.error.empty() && recovery.found == 0) {
+    rfbsim::log::error("manager", "cannot mark the sessions the previous run left as interrupted: %s",
+                       recovery.error.c_str());
+  } else if (recovery.recorded < recovery.found) {
+    rfbsim::log::error("manager",
+                       "%d session(s) left by the previous run are interrupted, but the index took only %d of them "
+                       "(%s); the rest is written again until it does",
+                       recovery.found, recovery.recorded, recovery.error.c_str());
+  } else if (recovery.found > 0) {
+    rfbsim::log::info("manager", "marked %d session(s) left by the previous run as interrupted", recovery.found);
   }
   // Before the first link: the index says what happened to the previous run's sessions.
   supervisor.flush_index();

@@ -13,7 +13,7 @@ constexpr Rejection kAllRejections[] = {
     Rejection::kCompleted,      Rejection::kUnknownSession, Rejection::kEndedSession,
     Rejection::kForbiddenOrigin, Rejection::kUnauthorized, Rejection::kStartFailed,
     Rejection::kRateLimited,    Rejection::kConnectionLimit, Rejection::kUnspentLimit,
-    Rejection::kHead};
+    Rejection::kHead,           Rejection::kCannotRecord};
 
 std::string number(double value) {
   char text[32];
@@ -60,6 +60,7 @@ const char* rejection_name(Rejection reason) {
     case Rejection::kConnectionLimit: return "connection_limit";
     case Rejection::kUnspentLimit: return "unspent_limit";
     case Rejection::kHead: return "head_preview";
+    case Rejection::kCannotRecord: return "cannot_record";
   }
   return "other";
 }
@@ -129,6 +130,9 @@ std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions
   header(out, "rfbsim_accept_errors_total", "counter",
          "Failed accepts on the public port (EMFILE: out of descriptors), each followed by a short pause.");
   out += "rfbsim_accept_errors_total " + std::to_string(accept_errors_) + "\n";
+  header(out, "rfbsim_index_write_errors_total", "counter",
+         "Failed writes of the session index or a session's manager.json (a full disk); each is kept and retried.");
+  out += "rfbsim_index_write_errors_total " + std::to_string(index_write_errors_) + "\n";
   header(out, "rfbsim_connections", "gauge", "Connections open on the public port now.");
   out += "rfbsim_connections " + std::to_string(connections_open_) + "\n";
   header(out, "rfbsim_connection_addresses", "gauge", "Client addresses with a connection open now.");

@@ -28,6 +28,7 @@ enum class Rejection {
   kConnectionLimit, ///< a connection over the per-address or total cap, closed at accept
   kUnspentLimit,    ///< an address that started too many sessions nobody has seen yet (429)
   kHead,            ///< a HEAD (link preview) of /start: answered, nothing started
+  kCannotRecord,    ///< the session index cannot take a new session's row (a full disk): nothing started
 };
 
 const char* rejection_name(Rejection reason);
@@ -75,6 +76,8 @@ class Metrics {
   void count_pong_timeout() { ++pong_timeouts_; }
   /// accept() failed (e.g. EMFILE: no descriptor left) and accepting paused for a moment.
   void count_accept_error() { ++accept_errors_; }
+  /// A write of the session index (or a session's manager.json) failed; it is kept and tried again.
+  void count_index_write_error() { ++index_write_errors_; }
   /// Gauges of the public port's connections, set by the frontend before rendering.
   void set_connections(std::size_t open, std::size_t addresses) {
     connections_open_ = open;
@@ -85,6 +88,7 @@ class Metrics {
   [[nodiscard]] std::uint64_t rejections(Rejection reason) const;
   [[nodiscard]] std::uint64_t bytes_to_client() const { return bytes_to_client_; }
   [[nodiscard]] std::uint64_t takeovers() const { return takeovers_; }
+  [[nodiscard]] std::uint64_t index_write_errors() const { return index_write_errors_; }
 
   /// The exposition text. `sessions_by_state`: live sessions by state now, and ended ones by state over
   /// the whole index; `relays`: WebSocket relays open now; `streams`: live sessions' streams, for
@@ -104,6 +108,7 @@ class Metrics {
   std::uint64_t takeovers_ = 0;
   std::uint64_t pong_timeouts_ = 0;
   std::uint64_t accept_errors_ = 0;
+  std::uint64_t index_write_errors_ = 0;
   std::size_t connections_open_ = 0;
   std::size_t connection_addresses_ = 0;
 };

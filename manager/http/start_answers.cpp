@@ -15,6 +15,8 @@ constexpr int kBusyRetrySeconds = 10;
 constexpr int kUndecidedRetrySeconds = 5;
 // How long the "previous session is closing" page waits: an ending session is gone within the stop grace.
 constexpr int kPreviousEndingRetrySeconds = 3;
+// How long the "cannot save sessions" page asks to wait: space on a full disk comes back by a person's hand.
+constexpr int kCannotRecordRetrySeconds = 60;
 
 PageAnswer page(int status, std::string html, Headers headers = {},
                 std::optional<Rejection> rejection = std::nullopt) {
@@ -54,6 +56,13 @@ PageAnswer answer_start_outcome(const StartOutcome& outcome, const ManagerConfig
       const auto retry = std::max<long long>(1, std::min<long long>(config.idle_timeout.count(), 60));
       return page(429, busy_page(static_cast<int>(retry)), retry_after(retry), Rejection::kUnspentLimit);
     }
+    case StartOutcome::Kind::kCannotRecord:
+      // Nothing started: a session the study cannot record must not run. The disk may have room again soon.
+      return page(503,
+                  error_page(503, "The simulation cannot start right now",
+                             "The study's server cannot save new sessions at the moment. Please try the link again in "
+                             "a few minutes, or tell the researcher."),
+                  retry_after(kCannotRecordRetrySeconds), Rejection::kCannotRecord);
     case StartOutcome::Kind::kFailed: break;
   }
   return page(503, error_page(503, "The simulation could not start",

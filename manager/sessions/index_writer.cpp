@@ -53,7 +53,7 @@ void IndexWriter::run() {
       if (job.insert) {
         index_.insert(job.session);
       } else {
-        index_.update(job.session);
+        index_.write(job.session);  // the row too, where its insert had failed
       }
     } catch (const std::exception& failure) {
       error = std::string("cannot write the index: ") + failure.what();
@@ -76,13 +76,19 @@ std::string write_session_record(const Session& session) {
   if (!std::filesystem::is_directory(folder, ec)) return "";  // never made (a failed start): nothing to keep
   const std::filesystem::path target = folder / "manager.json";
   const std::filesystem::path temporary = folder / ".manager.json.tmp";
+  bool written = false;
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     out << session_record_json(session);
-    if (!out.flush()) return "cannot write " + target.string();
+    written = static_cast<bool>(out.flush());
   }
-  std::filesystem::rename(temporary, target, ec);
-  if (ec) return "cannot write " + target.string() + ": " + ec.message();
+  if (written) std::filesystem::rename(temporary, target, ec);
+  if (!written || ec) {
+    // No half-written or empty temporary is left behind on a full disk; the last whole manager.json stays.
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    return "cannot write " + target.string() + (ec ? ": " + ec.message() : std::string());
+  }
   return "";
 }
 

@@ -35,7 +35,7 @@ class IndexWriter {
 
   /// Queues a new row for `session` (its id already chosen) and its manager.json.
   void insert(Session session, Done done);
-  /// Queues `session`'s mutable fields and its manager.json.
+  /// Queues `session`'s mutable fields and its manager.json (its whole row where the index has none yet).
   void update(Session session, Done done);
   /// Blocks until everything queued so far is written (tests, shutdown).
   void drain();

@@ -330,6 +330,22 @@ void SessionIndex::update(const Session& s) {
   }
 }
 
+void SessionIndex::write(const Session& s) {
+  bool present = false;
+  {
+    // Finished before the write: a read still open would make the write an upgrade of its snapshot, which
+    // SQLite refuses at once (no busy wait) whenever another connection wrote meanwhile.
+    Statement select(db_, "SELECT 1 FROM sessions WHERE id = ?");
+    select.bind(1, s.id);
+    present = select.step();
+  }
+  if (present) {
+    update(s);
+  } else {
+    insert(s);
+  }
+}
+
 std::vector<Session> SessionIndex::query(const std::string& where, const std::vector<std::string>& binds) {
   Statement select(db_, std::string("SELECT ") + kColumns + " FROM sessions " + where);
   for (std::size_t i = 0; i < binds.size(); ++i) select.bind(static_cast<int>(i + 1), binds[i]);

@@ -39,6 +39,8 @@ class SessionIndex {
   /// times) to its row; session.copy_state only where the row has none yet (a copy starts as 'pending'; from
   /// then on the copy columns are set_copy_status's alone).
   void update(const Session& session);
+  /// update(), or insert() where the index has no row of session.id yet (its first write had failed).
+  void write(const Session& session);
   /// Records a session's after-session copy: its state ("pending", "done", "failed"), tries so far and last
   /// failure. Throws std::runtime_error when there is no such session.
   void set_copy_status(std::int64_t id, const std::string& state, int attempts, const std::string& error);

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <array>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/posix/stream_descriptor.hpp>
@@ -33,6 +34,8 @@
 #include "sessions/session_views.hpp"
 #include "admission/tokens.hpp"
 #include "x11_display.hpp"
+#include "rfbsim/log.hpp"
+#include "sessions/socket_folder.hpp"
 #include "sessions/supervisor_runtime.hpp"
 
 namespace rfbsim::manager {
@@ -49,19 +52,24 @@ constexpr auto kPortPollInterval = std::chrono::milliseconds(20);
 // shorter): more without a newline is nonsense, and the pipe is not listened to any more.
 constexpr std::size_t kMaxPipeLine = 256;
 
-// A private folder for the sessions' unix sockets: mode 0700 from mkdtemp, so that only the manager's user can
-// even reach the sockets (which sim_rfb also makes 0600). Short, under the temporary directory, because a
-// socket path must fit in 108 bytes; "" (TCP ports instead) when that cannot be had.
-std::string make_socket_dir() {
+// The longest pause between tries of a write the index refused: space freed on a full disk is taken up soon.
+constexpr std::chrono::seconds kMaxIndexRetry{30};
+
+// The highest id a session folder under `sessions_dir` carries ("<id>-<uid>"), 0 when none: a session whose row
+// never reached the index (a full disk) may still have left its folder, and its id must not name a second one.
+std::int64_t highest_folder_id(const std::filesystem::path& sessions_dir) {
+  std::int64_t highest = 0;
   std::error_code ec;
-  std::string pattern = (std::filesystem::temp_directory_path(ec) / "rfbsim-manager-XXXXXX").string();
-  if (ec || pattern.size() > 80) pattern = "/tmp/rfbsim-manager-XXXXXX";
-  if (::mkdtemp(pattern.data()) == nullptr) {
-    std::fprintf(stderr, "[manager] cannot make a folder for session sockets (%s); sessions use loopback ports\n",
-                 std::strerror(errno));
-    return "";
+  for (std::filesystem::directory_iterator it(sessions_dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    const std::size_t dash = name.find('-');
+    std::int64_t id = 0;
+    const auto [ptr, error] = std::from_chars(name.data(), name.data() + (dash == std::string::npos ? 0 : dash), id);
+    if (dash != std::string::npos && dash > 0 && error == std::errc() && ptr == name.data() + dash) {
+      highest = std::max(highest, id);
+    }
   }
-  return pattern;
+  return highest;
 }
 
 }  // namespace
@@ -80,13 +88,18 @@ Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::s
   // x11 sessions always use it: their RFB socket and Xauthority must be the manager's user's alone.
   if ((config_.session_kind == SessionKind::kSimRfb && config_.session_socket == "unix") ||
       config_.session_kind == SessionKind::kX11) {
-    socket_dir_ = make_socket_dir();
+    // One per data directory, found again after a kill -9 (socket_folder.hpp).
+    socket_folder_ = std::make_unique<SocketFolder>(config_.data_dir);
+    socket_dir_ = socket_folder_->path();
+    if (!socket_folder_->note().empty()) rfbsim::log::info("manager", "%s", socket_folder_->note().c_str());
+    if (socket_dir_.empty()) rfbsim::log::warn("manager", "sessions use loopback ports instead of unix sockets");
     // An x11 session's RFB socket and cookie have nowhere else to go that only the manager's user can reach.
     if (socket_dir_.empty() && config_.session_kind == SessionKind::kX11) {
       throw std::runtime_error("session_kind x11 needs a private folder for the sessions' sockets and cookies");
     }
   }
-  next_id_ = index_.max_id() + 1;
+  next_id_ = std::max(index_.max_id(), highest_folder_id(std::filesystem::absolute(config_.data_dir) / "sessions")) + 1;
+  index_retry_ = std::make_unique<asio::steady_timer>(io_);
   for (const auto& [state, count] : index_.count_by_state()) {
     if (!is_live(state)) ended_counts_[state] = count;
   }
@@ -108,9 +121,13 @@ Supervisor::Supervisor(asio::io_context& io, const ManagerConfig& config, std::s
 Supervisor::~Supervisor() {
   launcher_.reset();  // starts nothing more
   writer_.reset();    // writes what is queued
-  if (socket_dir_.empty()) return;
-  std::error_code ignored;
-  std::filesystem::remove_all(socket_dir_, ignored);
+  if (const std::size_t behind = unrecorded(); behind > 0) {
+    rfbsim::log::error("manager",
+                       "the index could not take the last changes of %zu session(s) (a full disk?): it is behind; "
+                       "the next start marks sessions it still shows as live interrupted",
+                       behind);
+  }
+  socket_folder_.reset();  // removes the folder and what is left in it
 }
 
 void Supervisor::wait_for_children() {
@@ -134,12 +151,22 @@ void Supervisor::insert_row(const Session& session, std::function<void(const std
 void Supervisor::queue_write(bool insert, const Session& session, std::function<void(const std::string&)> committed) {
   // The table (or the caller) has the newest version now; the index gets it in order, off this thread.
   const std::uint64_t sequence = ++write_sequence_;
-  unsaved_[session.id] = {sequence, session};
+  unsaved_[session.id] = {sequence, session, false};
   auto done = [this, id = session.id, sequence, committed = std::move(committed)](const std::string& error) {
     asio::post(io_, [this, id, sequence, error, committed] {
       const auto it = unsaved_.find(id);
-      if (it != unsaved_.end() && it->second.first == sequence) unsaved_.erase(it);
-      if (!error.empty()) std::fprintf(stderr, "[manager] session %lld: %s\n", static_cast<long long>(id), error.c_str());
+      const bool newest = it != unsaved_.end() && it->second.sequence == sequence;
+      if (error.empty()) {
+        if (newest) unsaved_.erase(it);
+      } else {
+        // Kept, served as the truth meanwhile, and written again until the index takes it.
+        metrics_.count_index_write_error();
+        rfbsim::log::limited(rfbsim::log::Level::kError, "index-write", "manager",
+                             "session %lld: %s (kept, and written again once the index takes it)",
+                             static_cast<long long>(id), error.c_str());
+        if (newest) it->second.refused = true;
+        schedule_index_retry();
+      }
       if (committed) committed(error);
     });
   };
@@ -150,10 +177,43 @@ void Supervisor::queue_write(bool insert, const Session& session, std::function<
   }
 }
 
+void Supervisor::schedule_index_retry() {
+  if (index_retry_->expiry() > asio::steady_timer::clock_type::now()) return;  // a retry is already due
+  index_retry_->expires_after(index_retry_delay_);
+  index_retry_->async_wait([this](const boost::system::error_code& ec) {
+    if (ec) return;
+    std::vector<Session> again;
+    for (const auto& [id, unsaved] : unsaved_) {
+      if (unsaved.refused) again.push_back(unsaved.session);
+    }
+    if (again.empty()) {
+      index_retry_delay_ = std::chrono::seconds(1);
+      return;
+    }
+    index_retry_delay_ = std::min(index_retry_delay_ * 2, kMaxIndexRetry);
+    // An update writes the whole row where the index has none yet, so a session whose insert failed is recorded.
+    for (const Session& session : again) {
+      save(session, [this, id = session.id](const std::string& error) {
+        if (error.empty() && unsaved_.count(id) == 0) {
+          index_retry_delay_ = std::chrono::seconds(1);
+          rfbsim::log::limited(rfbsim::log::Level::kInfo, "index-caught-up", "manager",
+                               "session %lld: the index took the change it had refused", static_cast<long long>(id));
+        }
+      });
+    }
+  });
+}
+
+std::size_t Supervisor::unrecorded() const {
+  std::size_t count = 0;
+  for (const auto& [id, unsaved] : unsaved_) count += unsaved.refused ? 1 : 0;
+  return count;
+}
+
 std::optional<Session> Supervisor::latest_for_uid(const std::string& uid) {
   std::optional<Session> latest = index_.latest_for_uid(uid);
   for (const auto& [id, queued] : unsaved_) {
-    if (queued.second.uid == uid && (!latest || id >= latest->id)) latest = queued.second;
+    if (queued.session.uid == uid && (!latest || id >= latest->id)) latest = queued.session;
   }
   return latest;
 }
@@ -162,14 +222,16 @@ bool Supervisor::has_session_for_uid(const std::string& uid) {
   return table_.by_uid(uid) != nullptr || latest_for_uid(uid).has_value();
 }
 
-int Supervisor::recover_interrupted() {
+Supervisor::Recovery Supervisor::recover_interrupted() {
+  Recovery recovery;
   std::vector<Session> left;
   try {
     left = index_.live_sessions(config_.host_id);
   } catch (const std::exception& error) {
-    std::fprintf(stderr, "[manager] cannot read the index: %s\n", error.what());
-    return 0;
+    recovery.error = std::string("cannot read the index: ") + error.what();
+    return recovery;
   }
+  recovery.found = static_cast<int>(left.size());
   for (Session& session : left) {
     // The group is ours if its leader is the very process we started (same start time), or if no process
     // has that id any more (then only members of our old group can carry it). A reused id is left alone.
@@ -185,10 +247,28 @@ int Supervisor::recover_interrupted() {
     session.state = SessionState::kInterrupted;
     session.detail = "the manager stopped unexpectedly while the session ran";
     session.ended_at = std::chrono::system_clock::now();
-    save(session, copy_after_commit(session));
+    const auto copy = copy_after_commit(session);
     ++ended_counts_[SessionState::kInterrupted];
+    // Written here and now, through the I/O thread's own connection (nothing else runs yet), so that what the
+    // start-up says it marked is what the index holds. A refusal joins the other writes to try again.
+    std::string error;
+    try {
+      index_.update(session);
+      error = write_session_record(session);
+    } catch (const std::exception& failure) {
+      error = std::string("cannot write the index: ") + failure.what();
+    }
+    if (error.empty()) {
+      ++recovery.recorded;
+      if (copy) copy("");
+      continue;
+    }
+    recovery.error = error;
+    metrics_.count_index_write_error();
+    unsaved_[session.id] = {++write_sequence_, session, true};
+    schedule_index_retry();
   }
-  return static_cast<int>(left.size());
+  return recovery;
 }
 
 void Supervisor::notify_if_all_gone() {
@@ -332,7 +412,7 @@ void Supervisor::mark_ready(Session& session, int port) {
 std::optional<Session> Supervisor::find(const std::string& token) {
   if (Session* live = table_.by_token(token)) return *live;
   for (const auto& [id, queued] : unsaved_) {
-    if (queued.second.token == token) return queued.second;
+    if (queued.session.token == token) return queued.session;
   }
   try {
     return index_.find_by_token(token);
@@ -354,9 +434,9 @@ std::vector<Session> Supervisor::recent(int limit) {
   for (const auto& [id, queued] : unsaved_) {
     const auto row = std::find_if(rows.begin(), rows.end(), [id = id](const Session& r) { return r.id == id; });
     if (row != rows.end()) {
-      *row = queued.second;
+      *row = queued.session;
     } else {
-      rows.push_back(queued.second);
+      rows.push_back(queued.session);
     }
   }
   std::sort(rows.begin(), rows.end(), [](const Session& a, const Session& b) { return a.id > b.id; });

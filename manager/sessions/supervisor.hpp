@@ -6,6 +6,7 @@
 #pragma once
 
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -41,11 +42,14 @@ struct StartOutcome {
   /// participant has seen yet.
   /// kPreviousEnding: the uid's own session is still ending (seconds from gone); not kBusy, so that nobody
   /// retries on another host, where a second session of the uid would start.
-  enum class Kind { kJoined, kStarted, kBusy, kCompleted, kFailed, kTooManyUnspent, kPreviousEnding } kind =
+  /// kCannotRecord: the index could not take the new session's row (a full disk), so nothing was started.
+  enum class Kind { kJoined, kStarted, kBusy, kCompleted, kFailed, kTooManyUnspent, kPreviousEnding, kCannotRecord } kind =
       Kind::kFailed;
   std::string token;    ///< kJoined, kStarted
   std::string message;  ///< kFailed: why, for the log and the page
 };
+
+class SocketFolder;  // sessions/socket_folder.hpp
 
 class Supervisor {
  public:
@@ -58,9 +62,18 @@ class Supervisor {
 
   void set_listener(SessionListener* listener) { listener_ = listener; }
 
+  /// What recover_interrupted found and what of it the index took.
+  struct Recovery {
+    int found = 0;        ///< sessions the index said were live on this host
+    int recorded = 0;     ///< of them, marked interrupted in the index now
+    std::string error;    ///< why the others were not (they are kept and tried again with the other writes)
+  };
   /// After a restart: ends the processes of sessions the index says are live on this host (if they still
-  /// run) and marks those sessions interrupted. Returns how many there were.
-  int recover_interrupted();
+  /// run) and marks those sessions interrupted, writing the index at once (nothing else runs yet).
+  Recovery recover_interrupted();
+
+  /// Sessions whose newest version the index has not taken yet (a full disk), kept in memory and tried again.
+  [[nodiscard]] std::size_t unrecorded() const;
 
   /// What /start answers with, called on the I/O thread.
   using StartReply = std::function<void(const StartOutcome&)>;
@@ -141,6 +154,11 @@ class Supervisor {
   void save(const Session& session, std::function<void(const std::string&)> committed = nullptr);
   void insert_row(const Session& session, std::function<void(const std::string&)> committed);
   void queue_write(bool insert, const Session& session, std::function<void(const std::string&)> committed);
+  // Writes again, after a pause that doubles up to kMaxIndexRetry, every version the index refused.
+  void schedule_index_retry();
+  // The launch of a session whose row is committed; a session the index refused, or one ended meanwhile, is
+  // never launched and ends here.
+  void launch_recorded(std::int64_t id, LaunchJob job, const std::string& insert_error, StartReply reply);
   // The uid's newest session in the index or among writes still queued.
   std::optional<Session> latest_for_uid(const std::string& uid);
   std::string session_log_tail(const Session& session) const;
@@ -167,7 +185,8 @@ class Supervisor {
   std::function<void()> on_all_gone_;  // set by shutdown()
   bool shutting_down_ = false;
   bool draining_ = false;  // set_draining
-  std::string socket_dir_;  // private folder (0700) of the sessions' unix sockets; "" = they use TCP ports
+  std::unique_ptr<SocketFolder> socket_folder_;  // the sessions' private socket folder, while it is held
+  std::string socket_dir_;  // its path (0700): the sessions' unix sockets; "" = they use TCP ports
   std::unique_ptr<IndexWriter> writer_;  // the index's writes, off this thread
   // Session starts, off this thread; its thread must outlive the sessions it started (PR_SET_PDEATHSIG).
   std::unique_ptr<ProcessLauncher> launcher_;
@@ -175,9 +194,17 @@ class Supervisor {
   // after_session_command's runs, on a thread of their own; null without one. It reaps its own child.
   std::unique_ptr<SessionCopier> copier_;
   std::int64_t next_id_ = 1;             // session ids are handed out here, above the index's highest
-  // Sessions whose latest version is queued for the writer, by id: (write sequence, that version). Reads of
-  // the index look here first, so that they never see an older row than the table did.
-  std::map<std::int64_t, std::pair<std::uint64_t, Session>> unsaved_;
+  // Sessions whose latest version is queued for the writer, or was refused by it (a full disk) and waits to be
+  // tried again, by id. Reads of the index look here first, so that they never see an older row than the table
+  // did: what the index could not take is still served as the truth.
+  struct Unsaved {
+    std::uint64_t sequence = 0;  // of the newest write queued
+    Session session;             // that version
+    bool refused = false;        // its write failed; schedule_index_retry writes it again
+  };
+  std::map<std::int64_t, Unsaved> unsaved_;
+  std::unique_ptr<boost::asio::steady_timer> index_retry_;  // armed while some write waits to be tried again
+  std::chrono::seconds index_retry_delay_{1};
   std::uint64_t write_sequence_ = 0;
   std::map<SessionState, std::int64_t> ended_counts_;  // ended sessions by state, whole index
 };

@@ -178,16 +178,16 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
     return;
   }
 
-  // The slot is taken from here on, while the process starts on the launcher's thread (pid -1 until then). The
-  // row goes in now, so that every later change is an update of it; if the index cannot take it, the session
-  // cannot be recorded and must not run.
+  // The slot is taken from here on, while the row is written and then the process starts on the launcher's
+  // thread (pid -1 until then). The row goes in first, so that every later change is an update of it; a session
+  // the index cannot take cannot be recorded and never runs (launch_recorded).
   Session& kept = table_.add(std::move(session));
   auto& rt = *runtimes_.emplace(kept.id, std::make_unique<Runtime>(io_)).first->second;
   rt.started = SteadyClock::now();
   const std::int64_t id = kept.id;
-  insert_row(kept, [this, id](const std::string& error) {
-    Session* s = table_.by_id(id);
-    if (!error.empty() && s != nullptr) begin_end(*s, SessionState::kFailed, error);
+  ++launches_in_flight_;  // from here: a start whose pid the table lacks yet
+  insert_row(kept, [this, id, job = std::move(job), reply = std::move(reply)](const std::string& error) mutable {
+    launch_recorded(id, std::move(job), error, std::move(reply));
   });
 
   rt.expiry.expires_after(config_.max_duration);
@@ -204,11 +204,29 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
     begin_end(*s, SessionState::kFailed, "not ready after " + std::to_string(config_.start_timeout.count()) + " s");
   });
   arm_idle_timer(kept);
-  ++launches_in_flight_;
-  launcher_->launch(std::move(job), [this, id, reply = std::move(reply)](LaunchResult result) mutable {
-    asio::post(io_, [this, id, result = std::move(result), reply = std::move(reply)]() mutable {
-      launched(id, std::move(result), std::move(reply));
+}
+
+void Supervisor::launch_recorded(std::int64_t id, LaunchJob job, const std::string& insert_error, StartReply reply) {
+  Session* session = table_.by_id(id);
+  if (insert_error.empty() && session != nullptr && session->state != SessionState::kEnding) {
+    launcher_->launch(std::move(job), [this, id, reply = std::move(reply)](LaunchResult result) mutable {
+      asio::post(io_, [this, id, result = std::move(result), reply = std::move(reply)]() mutable {
+        launched(id, std::move(result), std::move(reply));
+      });
     });
+    return;
+  }
+  // Never launched: the index refused the row (it is kept and written again with the outcome below), or the
+  // session was ended while its row was written (shutdown, an administrator, the start deadline).
+  LaunchResult never;
+  never.error = !insert_error.empty() ? "cannot record the session, so it was not started: " + insert_error
+                                      : "ended before it started";
+  launched(id, std::move(never), [this, reply = std::move(reply), refused = !insert_error.empty()](
+                                     const StartOutcome& outcome) {
+    if (!refused) return reply(outcome);
+    StartOutcome cannot_record = outcome;
+    cannot_record.kind = StartOutcome::Kind::kCannotRecord;
+    reply(cannot_record);
   });
 }
 

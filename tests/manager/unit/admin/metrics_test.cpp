@@ -62,13 +62,14 @@ TEST_CASE("every series has its HELP and TYPE") {
                                                "# TYPE rfbsim_takeovers_total counter",
                                                "# TYPE rfbsim_pong_timeouts_total counter",
                                                "# TYPE rfbsim_accept_errors_total counter",
+      "# TYPE rfbsim_index_write_errors_total counter",
                                                "# TYPE rfbsim_connections gauge",
                                                "# TYPE rfbsim_connection_addresses gauge",
                                                "# TYPE rfbsim_session_rtt_ms gauge",
                                                "# TYPE rfbsim_session_fps gauge",
                                                "# TYPE rfbsim_session_codec_info gauge",
                                            });
-  CHECK(lines_starting(text, "# HELP ").size() == 16);
+  CHECK(lines_starting(text, "# HELP ").size() == 17);
 }
 
 TEST_CASE("sessions are listed for every state, zero included") {
@@ -172,6 +173,7 @@ TEST_CASE("rejections are counted by reason and every reason is listed") {
             "rfbsim_rejections_total{reason=\"connection_limit\"} 0",
             "rfbsim_rejections_total{reason=\"unspent_limit\"} 0",
             "rfbsim_rejections_total{reason=\"head_preview\"} 0",
+            "rfbsim_rejections_total{reason=\"cannot_record\"} 0",
         });
 }
 
