@@ -42,6 +42,7 @@
 #include "bench_util.hpp"
 #include "http_client.hpp"
 #include "manager_abuse.hpp"
+#include "manager_takeovers.hpp"
 #include "manager_clients.hpp"
 #include "manager_process.hpp"
 #include "manager_session.hpp"
@@ -90,6 +91,9 @@ struct Options {
   bench::SoakOptions soak_options;
   bool abuse = false;  // --abuse given: run the abuse comparison instead of tables 1-3
   bench::AbuseOptions abuse_options;
+  bool takeover_storm = false;  // --takeover-storm: run only the takeover storm (manager_takeovers.hpp)
+  bench::TakeoverStormOptions storm_options;
+  std::string manager_before;  // a second sim_manager the storm runs against too, side by side
 };
 
 Options parse_options(int argc, char** argv) {
@@ -128,6 +132,11 @@ Options parse_options(int argc, char** argv) {
           },
           "an IPv4 address"));
   cli.number("--storm-per-second", o.abuse_options.storm_per_second, 0, 1000, "the abuser's /start calls per second");
+  cli.flag("--takeover-storm", o.takeover_storm, "run the takeover storm instead of tables 1-3");
+  cli.number("--storm-upgrades", o.storm_options.upgrades, 1, 60000, "the takeover storm's upgrades");
+  cli.number("--storm-addresses", o.storm_options.addresses, 1, 240, "the takeover storm's source addresses");
+  cli.number("--storm-seconds", o.storm_options.seconds, 1, 600, "the takeover storm's duration");
+  cli.text("--manager-before", o.manager_before, "another sim_manager for the takeover storm to compare with");
   cli.parse(argc, argv);
   o.soak = cli.given("--soak");
   return o;
@@ -384,6 +393,25 @@ int run_soak_and_abuse(const Options& options, const std::string& load_at_start)
   return 0;
 }
 
+// --takeover-storm: the storm against this build's manager, and against --manager-before where given.
+int run_takeover_storm(const Options& options, const std::string& load_at_start) {
+  std::printf("bench_manager: CPU %s; load average %s at start\n\n", bench::cpu_description().c_str(),
+              load_at_start.c_str());
+  bench::raise_descriptor_limit(options.storm_options.upgrades + 4096L);  // every upgrade is held to the end
+  std::vector<bench::TakeoverStormResult> results;
+  std::vector<std::pair<std::string, std::string>> managers = {{"this build", options.manager}};
+  if (!options.manager_before.empty()) managers.insert(managers.begin(), {"before", options.manager_before});
+  for (const auto& [label, program] : managers) {
+    const std::string log = options.log + "." + (label == "before" ? "before" : "after");
+    std::ofstream(log, std::ios::trunc).close();
+    results.push_back(bench::run_takeover_storm({program, log, options.scenario}, label + " (" + program + ")",
+                                                options.storm_options));
+  }
+  bench::print_takeover_storm(results, options.storm_options);
+  std::printf("load average %s at the end\n", bench::load_average().c_str());
+  return 0;
+}
+
 int run(const Options& options) {
   if (!std::filesystem::is_regular_file(options.manager)) {
     throw std::runtime_error("no sim_manager at " + options.manager + " (build it, or pass --manager PATH)");
@@ -391,6 +419,7 @@ int run(const Options& options) {
   std::ofstream(options.log, std::ios::trunc).close();
   const std::string load_at_start = bench::load_average();
   if (options.soak || options.abuse) return run_soak_and_abuse(options, load_at_start);
+  if (options.takeover_storm) return run_takeover_storm(options, load_at_start);
   const auto started = Clock::now();
 
   FirstFrameResult first;
