@@ -29,6 +29,7 @@
 #include "sessions/launch_plan.hpp"
 #include "sessions/process_launcher.hpp"
 #include "record/digest.hpp"
+#include "rfbsim/log.hpp"
 #include "sessions/session_process.hpp"
 #include "sessions/session_views.hpp"
 #include "admission/tokens.hpp"
@@ -57,8 +58,8 @@ std::string make_socket_dir() {
   std::string pattern = (std::filesystem::temp_directory_path(ec) / "rfbsim-manager-XXXXXX").string();
   if (ec || pattern.size() > 80) pattern = "/tmp/rfbsim-manager-XXXXXX";
   if (::mkdtemp(pattern.data()) == nullptr) {
-    std::fprintf(stderr, "[manager] cannot make a folder for session sockets (%s); sessions use loopback ports\n",
-                 std::strerror(errno));
+    rfbsim::log::warn("manager", "cannot make a folder for session sockets (%s); sessions use loopback ports",
+                      std::strerror(errno));
     return "";
   }
   return pattern;
@@ -139,7 +140,7 @@ void Supervisor::queue_write(bool insert, const Session& session, std::function<
     asio::post(io_, [this, id, sequence, error, committed] {
       const auto it = unsaved_.find(id);
       if (it != unsaved_.end() && it->second.first == sequence) unsaved_.erase(it);
-      if (!error.empty()) std::fprintf(stderr, "[manager] session %lld: %s\n", static_cast<long long>(id), error.c_str());
+      if (!error.empty()) rfbsim::log::error("manager", "session %lld: %s", static_cast<long long>(id), error.c_str());
       if (committed) committed(error);
     });
   };
@@ -167,7 +168,7 @@ int Supervisor::recover_interrupted() {
   try {
     left = index_.live_sessions(config_.host_id);
   } catch (const std::exception& error) {
-    std::fprintf(stderr, "[manager] cannot read the index: %s\n", error.what());
+    rfbsim::log::error("manager", "cannot read the index: %s", error.what());
     return 0;
   }
   for (Session& session : left) {
@@ -337,7 +338,7 @@ std::optional<Session> Supervisor::find(const std::string& token) {
   try {
     return index_.find_by_token(token);
   } catch (const std::exception& error) {
-    std::fprintf(stderr, "[manager] cannot read the index: %s\n", error.what());
+    rfbsim::log::error("manager", "cannot read the index: %s", error.what());
     return std::nullopt;
   }
 }
