@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include <rfbsim/log.hpp>
 #include <rfbsim/offscreen_gl.hpp>
 #include <rfbsim/server.hpp>
 
@@ -233,6 +234,7 @@ int main(int argc, char** argv) {
     std::fputs(mujoco_rfb::usage().c_str(), stdout);
     return 0;
   }
+  rfbsim::log::set_level(parsed.options.log_level);  // checked by the parser
   try {
     return run(parsed.options);
   } catch (const std::exception& error) {

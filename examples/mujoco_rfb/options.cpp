@@ -30,6 +30,7 @@ void declare_options(CLI::App& app, Options& o) {
   app.add_option("--web-root", o.web_root, "directory holding the page (default: the built or installed rfbsim page, if any)")
       ->type_name("DIR")->check(cli::non_empty());
   app.add_flag("--rfb-only", o.rfb_only, "serve RFB only (raw and over WebSocket), no page: for sim_manager's sessions");
+  cli::add_log_level(app, o.log_level);
 }
 
 }  // namespace

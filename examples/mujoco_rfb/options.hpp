@@ -15,6 +15,7 @@ struct Options {
   int height = 480;                     ///< frame height in pixels, 120..2160
   std::string web_root;                 ///< page to serve over HTTP; empty = the built or installed one, if any
   bool rfb_only = false;                ///< serve no page at all (what sim_manager needs)
+  std::string log_level = "info";       ///< librfbsim's log: error, warn, info or debug (rfbsim/log.hpp)
   bool help = false;                    ///< --help was given
 };
 

@@ -30,6 +30,7 @@
 #include "sessions/launch_plan.hpp"
 #include "sessions/process_launcher.hpp"
 #include "record/digest.hpp"
+#include "rfbsim/log.hpp"
 #include "sessions/session_process.hpp"
 #include "sessions/session_views.hpp"
 #include "admission/tokens.hpp"
@@ -417,7 +418,7 @@ std::optional<Session> Supervisor::find(const std::string& token) {
   try {
     return index_.find_by_token(token);
   } catch (const std::exception& error) {
-    std::fprintf(stderr, "[manager] cannot read the index: %s\n", error.what());
+    rfbsim::log::error("manager", "cannot read the index: %s", error.what());
     return std::nullopt;
   }
 }

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "rfbsim/log.hpp"
 #include "session_options.hpp"
 #include "session_runner.hpp"
 
@@ -19,5 +20,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rfbsim_x11_session: %s (--help shows the usage)\n", parsed.error.c_str());
     return 2;
   }
+  rfbsim::log::set_level(parsed.options.log_level);  // checked by the parser
   return rfbsim::x11::run_session(parsed.options);
 }

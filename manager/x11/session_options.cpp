@@ -71,6 +71,7 @@ void declare_session_options(CLI::App& app, ParsedOptions& out) {
       ->type_name("N")->transform(cli::in_range(3, 1 << 20));
   app.add_option("--xvnc", o.xvnc, "the Xvnc binary (TigerVNC)")
       ->type_name("PATH")->capture_default_str()->check(cli::non_empty());
+  cli::add_log_level(app, o.log_level);
   app.add_option("PROGRAM", o.program,
                  "after '--': the program and its arguments (searched in PATH when it holds no '/')");
 }

@@ -16,6 +16,7 @@ struct SessionOptions {
   int depth = 24;                      ///< --depth: the screen's colour depth in bits (16 or 24)
   int ready_fd = -1;                   ///< --ready-fd: where to write the ready lines; -1: nowhere
   std::string xvnc = "/usr/bin/Xvnc";  ///< --xvnc: the Xvnc binary (TigerVNC)
+  std::string log_level = "info";      ///< --log-level: error, warn, info or debug (rfbsim/log.hpp)
   std::vector<std::string> program;    ///< after "--": the program and its arguments (program[0] searched in PATH
                                        ///< when it holds no '/')
 };

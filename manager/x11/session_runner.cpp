@@ -23,6 +23,7 @@
 
 #include "contract/ready_line.hpp"
 #include "child_process.hpp"
+#include "rfbsim/log.hpp"
 #include "x11_display.hpp"
 #include "xauthority.hpp"
 #include "xvnc_command.hpp"
@@ -40,7 +41,10 @@ constexpr std::chrono::milliseconds kProgramGrace{2000};   // SIGTERM to SIGKILL
 constexpr std::chrono::milliseconds kXvncGrace{2000};      // and for Xvnc
 constexpr const char* kXvncLog = "xvnc.log";
 
-void say(const std::string& line) { std::fprintf(stderr, "rfbsim_x11_session: %s\n", line.c_str()); }
+constexpr const char* kLogTag = "rfbsim_x11_session";
+
+// Most of what the launcher says is an error (it says nothing while all goes well), through the log sink.
+void say(const std::string& line) { log::write(log::Level::kError, kLogTag, line); }
 
 // A descriptor closed at scope exit.
 struct Fd {
@@ -71,7 +75,8 @@ struct Leftovers {
     struct stat info {};
     if (::lstat(rfb_socket.c_str(), &info) == 0 && S_ISSOCK(info.st_mode)) ::unlink(rfb_socket.c_str());
     if (display >= 0 && !remove_stale_display(display)) {
-      say("display :" + std::to_string(display) + " is still held by a live server; its files stay");
+      log::write(log::Level::kWarn, kLogTag,
+                 "display :" + std::to_string(display) + " is still held by a live server; its files stay");
     }
   }
 };

@@ -12,7 +12,8 @@ namespace rfbsim::x11 {
 /// ended first; 1 when Xvnc would not start, did not name its display within 10 s, or died; 0 after SIGTERM,
 /// SIGINT or SIGHUP; 2 when --ready-fd is not an open descriptor. Always removes, last, the Xauthority file, the
 /// RFB socket and the display's files if its server left them. Blocks SIGCHLD, SIGTERM, SIGINT and SIGHUP and
-/// ignores SIGPIPE in this process. Errors are one line each on stderr, starting "rfbsim_x11_session: ".
+/// ignores SIGPIPE in this process. Errors are one line each through the log sink (rfbsim/log.hpp, on stderr),
+/// tagged "[rfbsim_x11_session]".
 int run_session(const SessionOptions& options);
 
 }  // namespace rfbsim::x11

@@ -4,10 +4,11 @@
 
 #include <unistd.h>
 
-#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <utility>
+
+#include "rfbsim/log.hpp"
 
 namespace rfbsim::sim {
 
@@ -55,8 +56,7 @@ void SyncQueue::append(File file, std::string bytes) {
     const std::string amount = bound >= (1u << 20) ? std::to_string(bound >> 20) + " MiB" : std::to_string(bound >> 10) + " KiB";
     failure_ = one_line("the disk fell behind: more than " + amount + " waiting to be written");
     dropped_ += bytes.size();
-    std::fprintf(stderr, "[record] %s: %s; the session goes on, its data is incomplete\n", dir_.c_str(),
-                 failure_->c_str());
+    log::error("record", "%s: %s; the session goes on, its data is incomplete", dir_.c_str(), failure_->c_str());
     wake_.notify_one();
     return;
   }
@@ -214,7 +214,7 @@ void SyncQueue::perform(Step& step) {
       if (!failed) {
         fail(replaced.error);
       } else {
-        std::fprintf(stderr, "[record] %s: %s\n", dir_.c_str(), replaced.error.c_str());
+        log::warn("record", "%s: %s", dir_.c_str(), replaced.error.c_str());  // the failure was told already
       }
       return;
     }
@@ -227,13 +227,12 @@ void SyncQueue::fail(const std::string& reason) {
     std::lock_guard lock(mutex_);
     if (failure_) {
       // The queue had overflowed already: that stays the reason, this one is only logged.
-      std::fprintf(stderr, "[record] %s: %s\n", dir_.c_str(), reason.c_str());
+      log::warn("record", "%s: %s", dir_.c_str(), reason.c_str());
       return;
     }
     failure_ = one_line(reason);
   }
-  std::fprintf(stderr, "[record] %s: %s; the session goes on, its data is incomplete\n", dir_.c_str(),
-               reason.c_str());
+  log::error("record", "%s: %s; the session goes on, its data is incomplete", dir_.c_str(), reason.c_str());
   handle_failure();
 }
 
@@ -252,8 +251,7 @@ void SyncQueue::handle_failure() {
   }
   const FileResult noted = write_document();
   if (!noted.ok()) {
-    std::fprintf(stderr, "[record] %s: cannot note the failure in %s: %s\n", dir_.c_str(), kDocument,
-                 noted.error.c_str());
+    log::error("record", "%s: cannot note the failure in %s: %s", dir_.c_str(), kDocument, noted.error.c_str());
   }
 }
 

@@ -159,9 +159,16 @@ TEST_CASE("mujoco_rfb refuses bad flags with status 2 and a model it cannot load
   CHECK(WEXITSTATUS(unknown.status) == 2);
   CHECK_THAT(unknown.output, Catch::Contains("unknown argument '--scenario'"));
 
+  const auto loud = rfbsim::test::run_to_exit(MUJOCO_RFB_BINARY, {"--log-level", "loud"});
+  REQUIRE(WIFEXITED(loud.status));
+  CHECK(WEXITSTATUS(loud.status) == 2);
+  CHECK_THAT(loud.output, Catch::Contains("bad value 'loud' for --log-level (expected error, warn, info or debug)"));
+
   ScratchDir dir("mujoco_rfb_model");
   const std::string broken = dir.write("broken.xml", "<mujoco><worldbody><geom type='nonsense'/></worldbody>");
-  const auto bad_model = rfbsim::test::run_to_exit(MUJOCO_RFB_BINARY, {"--port", "0", "--model", broken});
+  // --log-level debug is taken: the model is what fails.
+  const auto bad_model =
+      rfbsim::test::run_to_exit(MUJOCO_RFB_BINARY, {"--port", "0", "--log-level", "debug", "--model", broken});
   REQUIRE(WIFEXITED(bad_model.status));
   CHECK(WEXITSTATUS(bad_model.status) == 1);
   CHECK_THAT(bad_model.output, Catch::Contains("cannot load the model '" + broken + "'"));

@@ -199,8 +199,14 @@ TEST_CASE("a log whose versions.rfbsim or versions.build differs from this build
     const test::ReplayRun forced = test::run_replay({edited.string(), "--force"});
     INFO(forced.output);
     CHECK(forced.exit_code == 0);  // the same build in truth: the poses match
-    CHECK(contains(forced.output, "warning: --force"));
+    CHECK(contains(forced.output, "[sim_replay] warning: --force"));
     CHECK(contains(forced.output, "poses match the log"));
+
+    // The warning is warn: --log-level error leaves it out, and the verdict on stdout stays.
+    const test::ReplayRun silent = test::run_replay({edited.string(), "--force", "--log-level", "error"});
+    CHECK(silent.exit_code == 0);
+    CHECK_FALSE(contains(silent.output, "warning: --force"));
+    CHECK(contains(silent.output, "poses match the log"));
   }
 }
 

@@ -127,8 +127,15 @@ TEST_CASE("sim_replay --data-dir --uid replays the session it finds across two h
                                                 "p-replay", "-q"});
   INFO(run.output);
   CHECK(run.exit_code == 0);
-  CHECK(contains(run.output, "sim_replay: session " + (store / "h2" / "4-p-replay").string() + " (host h2)"));
+  const std::string found = "[sim_replay] session " + (store / "h2" / "4-p-replay").string() + " (host h2)";
+  CHECK(contains(run.output, found));
   CHECK(contains(run.output, "poses match the log"));
+  // That line is info: --log-level warn leaves it out, and the verdict on stdout stays.
+  const test::ReplayRun quiet = test::run_replay(
+      {"--data-dir", h1.string(), "--data-dir", store.string(), "--uid", "p-replay", "-q", "--log-level", "warn"});
+  CHECK(quiet.exit_code == 0);
+  CHECK_FALSE(contains(quiet.output, found));
+  CHECK(contains(quiet.output, "poses match the log"));
 
   // The same uid on h1 as well: ambiguous (exit 2, both listed) until --host says which.
   copy_folder(store / "h2" / "4-p-replay", h1 / "sessions" / "9-p-replay");

@@ -64,6 +64,16 @@ TEST_CASE("the command line takes a session folder, the video and its view, the 
   CHECK(parse_cli({"--", "-odd-folder"}, error)->session_dir == "-odd-folder");
 }
 
+TEST_CASE("the command line takes the log's level names for --log-level, info by default") {
+  CliError error;
+  CHECK(parse_cli({"s"}, error)->log_level == "info");
+  const auto debug = parse_cli({"s", "--log-level", "debug"}, error);
+  REQUIRE(debug);
+  CHECK(debug->log_level == "debug");
+  CHECK_FALSE(parse_cli({"s", "--log-level", "loud"}, error));
+  CHECK(error.message == "bad value 'loud' for --log-level (expected error, warn, info or debug)");
+}
+
 TEST_CASE("provenance names each versions field that differs from this build and these files") {
   sim::SessionMeta meta;
   meta.rfbsim_version = "0.1.0";
@@ -135,7 +145,7 @@ TEST_CASE("the progress line is quiet at first, then redraws on a terminal or wr
   CHECK(terminal.step(21.0, 2.6).empty());  // redrawn at most four times a second
   CHECK(terminal.finish() == "\n");
   ProgressLine log(100.0, false, 0.0);
-  CHECK(log.step(5.0, 1.0) == "sim_replay: 5.0 / 100.0 s simulated (5 %), 5.0x real time\n");
+  CHECK(log.step(5.0, 1.0) == "5.0 / 100.0 s simulated (5 %), 5.0x real time");
   CHECK(log.step(9.0, 2.0).empty());
   CHECK_FALSE(log.step(10.0, 2.0).empty());
   CHECK(log.finish().empty());

@@ -81,6 +81,17 @@ TEST_CASE("the command line takes one or more data folders, an optional out fold
   CHECK_THAT(usage_text(), Catch::Contains("--out DIR"));
 }
 
+TEST_CASE("the command line takes the log's level names for --log-level, info by default") {
+  CliError error;
+  CHECK(parse_cli({"data"}, error)->log_level == "info");
+  const auto options = parse_cli({"data", "--log-level", "debug"}, error);
+  REQUIRE(options.has_value());
+  CHECK(options->log_level == "debug");
+  CHECK_FALSE(parse_cli({"data", "--log-level", "loud"}, error).has_value());
+  CHECK(error.message == "bad value 'loud' for --log-level (expected error, warn, info or debug)");
+  CHECK_THAT(usage_text(), Catch::Contains("--log-level error|warn|info|debug"));
+}
+
 TEST_CASE("the progress bar redraws one line on a terminal and prints a line per tenth in a log") {
   ProgressBar terminal(40, true);
   CHECK(terminal.step(1, 0.0) == "\r[" + std::string(30, '.') + "] 1/40 sessions");
@@ -95,8 +106,8 @@ TEST_CASE("the progress bar redraws one line on a terminal and prints a line per
     if (!line.empty()) lines.push_back(line);
   }
   REQUIRE(lines.size() == 11);  // 0 % (the first session), then 10 %, 20 %, ..., 100 %
-  CHECK(lines[1] == "sim_report: 10/100 sessions (10 %)\n");
-  CHECK(lines.back() == "sim_report: 100/100 sessions (100 %)\n");
+  CHECK(lines[1] == "10/100 sessions (10 %)");
+  CHECK(lines.back() == "100/100 sessions (100 %)");
   CHECK(log.finish().empty());
 
   ProgressBar small(5, true);

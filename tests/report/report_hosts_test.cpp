@@ -207,14 +207,14 @@ TEST_CASE("sim_report takes several data folders, writes to the first one's repo
 
   CHECK(sim_report(scratch, quoted(h1) + " " + quoted(h2)) == 0);
   const std::string err = read_text(scratch.path() / "stderr.txt");
-  CHECK_THAT(err, Catch::Contains("sim_report: warning: duplicate uid: uid 'p001' has sessions on 2 hosts: h1 (") &&
+  CHECK_THAT(err, Catch::Contains("[sim_report] warning: duplicate uid: uid 'p001' has sessions on 2 hosts: h1 (") &&
                       Catch::Contains("; flagged duplicate_uid\n") && Catch::Contains("3 sessions reported, 0 skipped"));
   CHECK(csv_records(read_text(h1 / "report" / "sessions.csv")).size() == 3);
 
   // The same folder twice: a note, counted once.
   CHECK(sim_report(scratch, quoted(h1) + " " + quoted(h1) + " --out " + quoted(scratch.path() / "out")) == 0);
   CHECK_THAT(read_text(scratch.path() / "stderr.txt"),
-             Catch::Contains("sim_report: note: ") && Catch::Contains("; counted once\n") &&
+             Catch::Contains("[sim_report] note: ") && Catch::Contains("; counted once\n") &&
                  Catch::Contains("1 sessions reported, 0 skipped"));
 
   // A data folder that is not there is a usage error, whichever it is.

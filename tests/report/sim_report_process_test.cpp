@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // The real sim_report binary on a generated data folder: its exit status, the files it writes, sessions.csv
-// parsing to the right rows, manager.json's warnings and left-out sessions on stderr, and the usage errors.
+// parsing to the right rows, manager.json's warnings and left-out sessions on stderr, what --log-level keeps of
+// them, and the usage errors.
 #include <catch2/catch.hpp>
 
 #include <string>
@@ -58,12 +59,32 @@ TEST_CASE("sim_report warns of a broken manager.json and says how many sessions 
 
   CHECK(sim_report(scratch, quoted(data)) == 0);
   const std::string err = read_text(scratch.path() / "stderr.txt");
-  CHECK_THAT(err, Catch::Contains("sim_report: warning: " + (data / "3-broken" / "manager.json").string() +
+  CHECK_THAT(err, Catch::Contains("[sim_report] warning: " + (data / "3-broken" / "manager.json").string() +
                                   ": key 'state': unknown state 'lost'; reported without it\n"));
   CHECK_THAT(err, Catch::Contains("3 sessions reported, 0 skipped\n"));
-  CHECK_THAT(err, Catch::Contains("sim_report: 1 of them without a participant (link never spent), left out of the "
-                                  "statistics\n"));
+  CHECK_THAT(err, Catch::Contains("[sim_report] 1 of them without a participant (link never spent), left out of "
+                                  "the statistics\n"));
   CHECK(csv_records(read_text(data / "report" / "summary.csv"))[0].at("sessions") == "2");
+}
+
+TEST_CASE("sim_report --log-level warn keeps the warnings and drops the counts, error drops both") {
+  ScratchDir scratch;
+  const auto data = scratch.path() / "data";
+  write_session(data / "1-broken", small_session());
+  write_text(data / "1-broken" / "manager.json", "{\"uid\": \"p001\", \"state\": \"lost\"}");
+
+  CHECK(sim_report(scratch, quoted(data) + " --log-level warn") == 0);
+  std::string err = read_text(scratch.path() / "stderr.txt");
+  CHECK_THAT(err, Catch::Contains("[sim_report] warning: " + (data / "1-broken" / "manager.json").string()));
+  CHECK_THAT(err, !Catch::Contains("sessions reported"));
+  CHECK(sim_report(scratch, quoted(data) + " --log-level error") == 0);
+  CHECK(read_text(scratch.path() / "stderr.txt").empty());
+  CHECK(sim_report(scratch, quoted(data) + " --log-level debug") == 0);
+  CHECK_THAT(read_text(scratch.path() / "stderr.txt"), Catch::Contains("1 sessions reported, 0 skipped\n"));
+
+  CHECK(sim_report(scratch, quoted(data) + " --log-level loud") == 2);
+  CHECK_THAT(read_text(scratch.path() / "stderr.txt"),
+             Catch::Contains("bad value 'loud' for --log-level (expected error, warn, info or debug)"));
 }
 
 TEST_CASE("sim_report exits 2 on usage errors and 0 for help") {

@@ -88,6 +88,17 @@ TEST_CASE("x11 session flags: each bad command line names its problem", "[x11]")
   CHECK(error_of(args) == "no program: name it after '--'");
 }
 
+TEST_CASE("x11 session flags: --log-level takes the log's level names", "[x11]") {
+  CHECK(parse_session_options(good()).options.log_level == "info");
+  Args args = good();
+  args.insert(args.begin(), {"--log-level", "debug"});
+  const auto parsed = parse_session_options(args);
+  REQUIRE(parsed.error.empty());
+  CHECK(parsed.options.log_level == "debug");
+  args[1] = "loud";
+  CHECK(error_of(args) == "bad value 'loud' for --log-level (expected error, warn, info or debug)");
+}
+
 TEST_CASE("x11 session flags: the RFB socket path fits a unix address", "[x11]") {
   Args args = good();
   args[1] = "/" + std::string(106, 'a');  // 107 bytes and the NUL: the most sun_path holds

@@ -26,9 +26,9 @@ std::string ProgressLine::step(double done_s, double elapsed_s) {
   last_tenth_ = tenth;
   shown_ = true;
   char line[160];
-  std::snprintf(line, sizeof line, "%ssim_replay: %.1f / %.1f s simulated (%d %%), %.1fx real time%s",
-                terminal_ ? "\r" : "", done_s, total_s_, percent, elapsed_s > 0.0 ? done_s / elapsed_s : 0.0,
-                terminal_ ? "   " : "\n");
+  std::snprintf(line, sizeof line, "%s%.1f / %.1f s simulated (%d %%), %.1fx real time%s",
+                terminal_ ? "\rsim_replay: " : "", done_s, total_s_, percent,
+                elapsed_s > 0.0 ? done_s / elapsed_s : 0.0, terminal_ ? "   " : "");
   return line;
 }
 

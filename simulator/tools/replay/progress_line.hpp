@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // ProgressLine: what sim_replay prints on stderr during a long replay. On a terminal, one line redrawn in
 // place ("\rsim_replay: 42.0 / 240.0 s simulated (17 %), 3.1x real time"); elsewhere (a log file), a line
-// at every tenth of the way. Quiet while the replay is young, so a short one prints nothing. Pure: it returns
-// the text and the caller writes it.
+// at every tenth of the way ("42.0 / 240.0 s simulated (17 %), 3.1x real time"), which the caller hands to the
+// log sink as it does its other lines. Quiet while the replay is young, so a short one prints nothing. Pure: it
+// returns the text and the caller writes it.
 #pragma once
 
 #include <string>
@@ -16,7 +17,7 @@ class ProgressLine {
   ProgressLine(double total_s, bool terminal, double quiet_s = 2.0);
 
   /// Text to print now that `done_s` simulated seconds are replayed, `elapsed_s` wall seconds after the start
-  /// ("" for nothing).
+  /// ("" for nothing): on a terminal, to write as it is; in a log, one line without its tag or newline.
   std::string step(double done_s, double elapsed_s);
   /// Text that ends the line: a newline after a terminal line that was drawn, else "".
   [[nodiscard]] std::string finish() const;

@@ -64,6 +64,7 @@ void declare_replay_cli(CLI::App& app, ReplayOptions& options, ReplayArgs& given
                "replay even when the log was recorded by another rfbsim version or build, or\n"
                "its scenario or map changed since (warns; the poses will likely differ)");
   app.add_flag("-q,--quiet", options.quiet, "no progress line on stderr");
+  cli::add_log_level(app, options.log_level);
 }
 
 }  // namespace

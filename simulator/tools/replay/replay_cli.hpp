@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // sim_replay's command line: `sim_replay SESSION_DIR [--video FILE] [--view participant|top] [--check-only]
-// [--out-dir DIR] [--force]`, or the session found by uid or id across hosts' data folders with
+// [--out-dir DIR] [--force] [--log-level L]`, or the session found by uid or id across hosts' data folders with
 // `--data-dir DIR... --uid UID|--session ID [--host HOST]` in place of SESSION_DIR; `--help`. Pure: parsing only.
 #pragma once
 
@@ -32,6 +32,7 @@ struct ReplayOptions {
   std::optional<std::filesystem::path> out_dir;  ///< --out-dir: keep the replay's own session data here
   bool force = false;                         ///< --force: replay despite a different build or scenario
   bool quiet = false;                         ///< --quiet: no progress line
+  std::string log_level = "info";             ///< --log-level: error, warn, info or debug (rfbsim/log.hpp)
 };
 
 /// A command line that cannot be run (exit 2); the message says what is wrong.

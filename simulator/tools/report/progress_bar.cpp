@@ -34,7 +34,7 @@ std::string ProgressBar::step(std::size_t done, double elapsed) {
   if (shown_ && tenth <= last_tenth_) return "";
   shown_ = true;
   last_tenth_ = tenth;
-  return "sim_report: " + count + " (" + std::to_string(tenth * 10) + " %)\n";
+  return count + " (" + std::to_string(tenth * 10) + " %)";
 }
 
 std::string ProgressBar::finish() const { return terminal_ && shown_ ? "\n" : ""; }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // ProgressBar: what sim_report prints on stderr while it reads sessions. On a terminal, one line redrawn
-// in place ("\r[#####.....] 12/372 sessions"); elsewhere (a log file), a line at every tenth of the way.
+// in place ("\r[#####.....] 12/372 sessions"); elsewhere (a log file), a line at every tenth of the way
+// ("12/372 sessions (0 %)"), which the caller hands to the log sink as it does its other lines.
 // Pure: it returns the text and the caller writes it.
 #pragma once
 
@@ -15,7 +16,8 @@ class ProgressBar {
   /// step reports more than `quiet_seconds` elapsed (a small report needs no bar; a slow one does).
   ProgressBar(std::size_t total, bool terminal, std::size_t quiet_up_to = 20, double quiet_seconds = 2.0);
 
-  /// Text to print now that `done` of the sessions are done, `elapsed` s after the start ("" for nothing).
+  /// Text to print now that `done` of the sessions are done, `elapsed` s after the start ("" for nothing): on a
+  /// terminal, to write as it is; in a log, one line without its tag or newline.
   std::string step(std::size_t done, double elapsed);
   /// Text that ends the bar: a newline after a terminal bar that was drawn, else "".
   std::string finish() const;

@@ -34,6 +34,7 @@ void declare_report_cli(CLI::App& app, CliOptions& options, std::vector<std::str
   app.add_option("--out", options.out_dir,
                  "where to write them (default: the first DATA_DIR's report/; created if needed)")
       ->type_name("DIR")->check(cli::non_empty());
+  cli::add_log_level(app, options.log_level);
 }
 
 }  // namespace

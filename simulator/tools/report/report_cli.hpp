@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// sim_report's command line: `sim_report DATA_DIR [DATA_DIR...] [--out DIR]`, `--help`. Pure: parsing only.
+// sim_report's command line: `sim_report DATA_DIR [DATA_DIR...] [--out DIR] [--log-level L]`, `--help`. Pure:
+// parsing only.
 #pragma once
 
 #include <filesystem>
@@ -15,6 +16,7 @@ struct CliOptions {
   /// DATA_DIR...: hosts' data folders, the shared store or a merged copy, at least one, in the order given.
   std::vector<std::filesystem::path> data_dirs;
   std::filesystem::path out_dir;  ///< --out, else the first DATA_DIR's report/
+  std::string log_level = "info";  ///< --log-level: error, warn, info or debug (rfbsim/log.hpp)
 };
 
 /// A command line that cannot be run (exit 2); the message says what is wrong.
