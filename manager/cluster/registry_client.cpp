@@ -129,7 +129,7 @@ void RegistryClient::resolve(const std::shared_ptr<Remote>& remote) {
           return;
         }
         if (!remote->warned) {
-          rfbsim::log::warn("registry", "peer %s: cannot resolve %s (%s); it counts as down until it does\n",
+          rfbsim::log::warn("registry", "peer %s: cannot resolve %s (%s); it counts as down until it does",
                             remote->peer.id.c_str(), remote->peer.address.c_str(), ec.message().c_str());
           remote->warned = true;
         }

@@ -297,7 +297,7 @@ class FrontendImpl final : public Frontend, public SessionListener {
     try {
       in.has_session = supervisor_.has_session_for_uid(uid);
     } catch (const std::exception& error) {
-      rfbsim::log::warn("manager", "/start of uid %s: cannot read the index (%s); asked to retry\n", uid.c_str(),
+      rfbsim::log::warn("manager", "/start of uid %s: cannot read the index (%s); asked to retry", uid.c_str(),
                         error.what());
     }
     in.shutting_down = supervisor_.shutting_down();

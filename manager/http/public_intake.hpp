@@ -134,7 +134,7 @@ class PublicIntake {
   void pause(const std::string& why) {
     metrics_.count_accept_error();
     if (!paused_) {
-      rfbsim::log::warn("manager", "accepting connections failed (%s); pausing %lld ms between tries\n", why.c_str(),
+      rfbsim::log::warn("manager", "accepting connections failed (%s); pausing %lld ms between tries", why.c_str(),
                         static_cast<long long>(kAcceptPause.count()));
     }
     paused_ = true;

@@ -19,6 +19,7 @@
 
 #include "rfbsim/log.hpp"
 #include "sessions/session.hpp"
+#include "sessions/session_log.hpp"
 #include "sessions/session_process.hpp"
 
 namespace rfbsim::manager {
@@ -40,10 +41,7 @@ constexpr std::size_t kMaxErrorTail = 200;
 const std::vector<std::string> kCopyVariables = {"USER", "LOGNAME", "SSH_AUTH_SOCK", "RCLONE_CONFIG",
                                                  "XDG_CONFIG_HOME"};
 
-void log_copy(const CopyJob& job, const std::string& text) {
-  rfbsim::log::info("manager", "session %lld (uid %s): %s", static_cast<long long>(job.session_id), job.uid.c_str(),
-                    text.c_str());
-}
+void log_copy(const CopyJob& job, const std::string& text) { log_about_session(job.session_id, job.uid, text); }
 
 // The last non-empty line of `file` from byte `from` on (what this try's command wrote), at most
 // kMaxErrorTail bytes of it.

@@ -17,6 +17,7 @@
 
 #include "sessions/supervisor.hpp"
 #include "rfbsim/log.hpp"
+#include "sessions/session_log.hpp"
 
 namespace rfbsim::manager {
 
@@ -43,8 +44,7 @@ struct Supervisor::ChildWatch {
 
 /// One line of the manager's log about `session`.
 inline void log_session(const Session& session, const std::string& text) {
-  rfbsim::log::info("manager", "session %lld (uid %s): %s", static_cast<long long>(session.id),
-               session.uid.c_str(), text.c_str());
+  log_about_session(session.id, session.uid, text);
 }
 
 }  // namespace rfbsim::manager
