@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // bench_nav: what the robot's stack costs and how well it navigates, over the seeded warehouse trials
-// (tests/nav/warehouse_trials.hpp: north_middle <-> dock among 15 pedestrians).
+// (tests/support/warehouse_trials.hpp: north_middle <-> dock among 15 pedestrians).
 //   Table 1: per-call cost of each stage (lidar, localization, costmaps, global plan, local plan), how often
 //            it runs per simulated second, and its share of one core; then the whole stack's share.
 //   Table 2: the navigation metrics of the trials (success, time to goal, path length, closest approach,

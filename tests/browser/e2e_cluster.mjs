@@ -61,7 +61,7 @@ const env = {
 };
 
 // ---------------------------------------------------------------------------------------------------------------
-// Ports: a cluster on base P uses P..P+303. As tests/cluster/cluster_under_test.cpp: bases 400 apart in
+// Ports: a cluster on base P uses P..P+303. As tests/support/cluster_under_test.cpp: bases 400 apart in
 // 20000..31600 never overlap one another and stay below the ephemeral ports that clients draw from.
 // ---------------------------------------------------------------------------------------------------------------
 function portIsFree(port) {

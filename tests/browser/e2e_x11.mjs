@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Browser end-to-end test of `session_kind: x11` (issue 21): sim_manager runs an unmodified X11 program per
 // session on its own TigerVNC Xvnc display, and a real Chromium reaches it through the bundled page.
-//   1. Our key-echo program (tests/x11/key_echo.cpp) behind a uid-only link: the page shows its picture, a key
+//   1. Our key-echo program (tests/support/x11_key_echo.cpp) behind a uid-only link: the page shows its picture, a key
 //      pressed in the page reaches the program (the picture changes, session.log gets `key w`), and the session
 //      ended through the admin API leaves no Xvnc, no program and no X socket of its display behind.
 //   2. The one-line demo, deploy/examples/x11-glxgears.yaml as shipped: glxgears turns in the page.
@@ -34,7 +34,7 @@ import {
 // ---------------------------------------------------------------------------------------------------------------
 const ADMIN_TOKEN = 'e2e-x11-admin-token-0123';   // 24 characters
 const GEOMETRY = { width: 640, height: 480 };     // the display of both parts (the demo's config says 640x480)
-const KEY_ECHO_BACKGROUND = [48, 48, 48];         // key_echo.cpp's window before any key
+const KEY_ECHO_BACKGROUND = [48, 48, 48];         // x11_key_echo.cpp's window before any key
 const MIN_KEY_CHANGED_FRACTION = 0.5;   // the background (below the top quarter's noise) turns a bright colour
 const MIN_GEARS_CHANGED_FRACTION = 0.002;   // glxgears' teeth turn: this share of pixels changes in a second
 const SESSION_GONE_TIMEOUT_MS = 10_000;     // the session's processes must be gone this soon after its end

@@ -43,7 +43,7 @@ struct Recording {
 Recording record_session(const RecordSpec& spec, const std::filesystem::path& dir);
 
 /// The tutorial completed with keys (W for the walk, A for the turn, Up for the camera, W to the goal),
-/// with codes OK-1 / LATE-2, as tests/task/study_session_test.cpp plays it.
+/// with codes OK-1 / LATE-2, as tests/app/study_session_test.cpp plays it.
 Recording record_tutorial(const std::filesystem::path& dir);
 
 /// What sim_replay did: its exit code (-1: no normal exit) and its stdout and stderr together.

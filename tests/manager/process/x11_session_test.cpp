@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // session_kind x11 with real parts: sim_manager starts rfbsim_x11_session, which runs TigerVNC's Xvnc and our
-// key-echo X11 program (tests/x11) on a private display; libvncclient reaches it through the manager's WebSocket
+// key-echo X11 program (tests/support) on a private display; libvncclient reaches it through the manager's WebSocket
 // relay. Checks the picture, a key reaching the program, that the session's files are private, and that
 // start/end cycles (and a SIGKILLed session) leave no process, display lock, X socket or RFB socket behind.
 // Built where CMake finds Xvnc and Xlib (tests/manager/process/CMakeLists.txt).

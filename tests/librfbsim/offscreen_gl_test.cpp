@@ -1,13 +1,12 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
+// OffscreenGL: an EGL context with no window, its MSAA choices and profiles, and frames read back top row
+// first, from its own framebuffer or from one the caller made. Run in rfbsim_unit_tests (tests/CMakeLists.txt).
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/gl.h>
 
 #include <catch2/catch.hpp>
 
-#include "render/gl_renderer.hpp"
-#include "render/scene_builder.hpp"
 #include "rfbsim/offscreen_gl.hpp"
-#include "world/demo_world.hpp"
 
 namespace {
 std::array<int, 4> pixel(const rfbsim::FrameView& f, int x, int y) {
@@ -86,35 +85,6 @@ TEST_CASE("without multisampling the picture is read straight from the drawing f
   const rfbsim::FrameView frame = plain.read_frame();
   CHECK(pixel(frame, 1, 1) == std::array<int, 4>{0, 255, 0, 255});
   CHECK(pixel(frame, 3, 60) == std::array<int, 4>{255, 0, 0, 255});
-}
-
-TEST_CASE("the demo scene renders sky above and the avatar's blue shirt at the centre") {
-  rfbsim::OffscreenGL gl({320, 240, 4, "auto"});
-  rfbsim::sim::GlRenderer renderer;
-  const auto world = rfbsim::sim::make_demo_world();
-  gl.begin_frame();
-  renderer.draw(rfbsim::sim::build_scene(world), 320, 240);
-  const auto frame = gl.read_frame();
-  // The avatar stands in front of the camera, so the centre column shows its shirt (0x2f7fd0, lit):
-  // blue dominates red there.
-  bool shirt = false;
-  for (int y = 100; y < 200 && !shirt; ++y) {
-    const auto p = pixel(frame, 160, y);
-    shirt = p[2] > p[0] + 60;
-  }
-  CHECK(shirt);
-  CHECK(renderer.last_triangles() > 100);
-}
-
-TEST_CASE("scenes compare equal until the world moves") {
-  auto world = rfbsim::sim::make_demo_world();
-  const auto a = rfbsim::sim::build_scene(world);
-  CHECK(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
-  world.avatar.pose.x += 0.001;
-  CHECK_FALSE(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
-  world = rfbsim::sim::make_demo_world();
-  world.camera.height += 0.1;
-  CHECK_FALSE(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
 }
 
 TEST_CASE("a compatibility-profile context draws with fixed-function GL, as MuJoCo 2.x's renderer does") {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Scene builder: people, props, landmarks and the robot are drawn where the world has them, inside their
-// boxes, with per-person looks and gaits, deterministically and within the item budget.
+// boxes, with per-person looks and gaits, deterministically and within the item budget; a scene compares equal to
+// a new one until the world moves.
 #include "render/scene_builder.hpp"
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <string>
 
 #include "render/scene_parts.hpp"
+#include "world/demo_world.hpp"
 
 namespace {
 
@@ -374,4 +376,15 @@ TEST_CASE("scene: a robot with a broken head angle is drawn whole, its head look
     CHECK(broken[i].model.matrix().allFinite());
     CHECK(broken[i].model.matrix().isApprox(ahead[i].model.matrix()));
   }
+}
+
+TEST_CASE("scenes compare equal until the world moves") {
+  auto world = rfbsim::sim::make_demo_world();
+  const auto a = rfbsim::sim::build_scene(world);
+  CHECK(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
+  world.avatar.pose.x += 0.001;
+  CHECK_FALSE(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
+  world = rfbsim::sim::make_demo_world();
+  world.camera.height += 0.1;
+  CHECK_FALSE(rfbsim::sim::same_scene(a, rfbsim::sim::build_scene(world)));
 }
