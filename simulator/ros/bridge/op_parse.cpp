@@ -1,32 +1,67 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// parse_op over nlohmann::json's callback parser, which reports each value's depth as it goes, so that a
-// deeply nested frame is refused while parsing instead of after.
+// parse_op: the frame's shape from a linear scan (depth, values), then nlohmann::json's plain parser.
 #include "ros/bridge/op_parse.hpp"
 
-#include <stdexcept>
+#include <algorithm>
 
 namespace rfbsim::ros {
 
-namespace {
-
-struct TooDeep : std::runtime_error {
-  TooDeep() : std::runtime_error("too deep") {}
-};
-
-}  // namespace
+JsonShape scan_json_shape(std::string_view text) {
+  JsonShape shape;
+  shape.values = 1;  // the top-level value, preceded by none of the characters counted below
+  int depth = 0;
+  bool in_string = false;
+  bool escaped = false;
+  for (const char c : text) {
+    // Inside a string only its end matters; "\"" and "\\" do not end it.
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+      continue;
+    }
+    // Every value and key follows one of '{', '[', ',' or ':', or opens the text.
+    switch (c) {
+      case '"':
+        in_string = true;
+        break;
+      case '{':
+      case '[':
+        ++shape.values;
+        shape.depth = std::max(shape.depth, ++depth);
+        break;
+      case '}':
+      case ']':
+        --depth;  // below zero only in text the parser refuses anyway
+        break;
+      case ',':
+      case ':':
+        ++shape.values;
+        break;
+      default:
+        break;
+    }
+  }
+  return shape;
+}
 
 ParsedOp parse_op(std::string_view text) {
   ParsedOp parsed;
-  const nlohmann::json::parser_callback_t limit_depth = [](int depth, nlohmann::json::parse_event_t,
-                                                           nlohmann::json&) {
-    if (depth > kMaxJsonDepth) throw TooDeep();
-    return true;
-  };
-  try {
-    parsed.message = nlohmann::json::parse(text.begin(), text.end(), limit_depth);
-  } catch (const TooDeep&) {
+  const JsonShape shape = scan_json_shape(text);
+  if (shape.depth > kMaxJsonDepth) {
     parsed.error = "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels";
     return parsed;
+  }
+  if (shape.values > kMaxJsonValues) {
+    parsed.error = "JSON with more than " + std::to_string(kMaxJsonValues) + " values and keys";
+    return parsed;
+  }
+  try {
+    parsed.message = nlohmann::json::parse(text.begin(), text.end());
   } catch (const nlohmann::json::exception& error) {
     parsed.error = std::string("malformed JSON: ") + error.what();
     return parsed;

@@ -259,6 +259,12 @@ bool RosbridgeHub::has_outgoing(int connection) const {
   return found != connections_.end() && !found->second->queue.empty();
 }
 
+std::uint64_t RosbridgeHub::dropped(int connection) const {
+  const std::lock_guard lock(mutex_);
+  const auto found = connections_.find(connection);
+  return found == connections_.end() ? 0 : found->second->queue.dropped();
+}
+
 std::optional<RosbridgeHub::Clock::time_point> RosbridgeHub::flush_due() {
   const std::lock_guard lock(mutex_);
   return flush_due_locked(now_());
@@ -278,7 +284,9 @@ std::string RosbridgeHub::subscribe(int connection, const std::string& topic, co
     return "already " + std::to_string(kMaxSubscriptions) + " subscriptions on this connection";
   }
   TopicSubscription& subscription = found->subscriptions[topic];
-  subscription.by_id[options.id] = options;
+  SubscribeOptions& kept = subscription.by_id[options.id];
+  kept = options;
+  kept.queue_length = std::min(options.queue_length, kMaxQueueLength);
   if (new_id) ++found->subscription_ids;
   subscription.merge();
   // Latched: the new subscriber hears the last message at once, whatever the throttle.

@@ -147,13 +147,16 @@ class RosbridgeHub {
   std::deque<Frame> take_outgoing(int connection, std::size_t max_bytes);
   /// True while frames wait for `connection`.
   [[nodiscard]] bool has_outgoing(int connection) const;
+  /// Frames dropped from `connection`'s queue to keep it within its bound so far (0 for an unknown id).
+  [[nodiscard]] std::uint64_t dropped(int connection) const;
   /// Queues throttled messages whose time has come; returns when the next one falls due (nullopt: none wait).
   std::optional<Clock::time_point> flush_due();
 
   /// Subscribes `connection` to declared `topic` (validated by the caller). Several subscriptions of one
-  /// connection to one topic merge as rosbridge does: the lowest throttle and the longest queue win. Returns
-  /// "" when subscribed (or the connection is gone), else why not: a new id beyond kMaxIdsPerTopic on the
-  /// topic or beyond kMaxSubscriptions on the connection is refused and nothing changes.
+  /// connection to one topic merge as rosbridge does: the lowest throttle and the longest queue win; a
+  /// queue_length over kMaxQueueLength counts as kMaxQueueLength. Returns "" when subscribed (or the
+  /// connection is gone), else why not: a new id beyond kMaxIdsPerTopic on the topic or beyond
+  /// kMaxSubscriptions on the connection is refused and nothing changes.
   std::string subscribe(int connection, const std::string& topic, const SubscribeOptions& options);
   /// Removes `connection`'s subscription `id` on `topic` ("" removes all of them); false when none matched.
   bool unsubscribe(int connection, const std::string& topic, const std::string& id);
@@ -208,6 +211,11 @@ class RosbridgeHub {
   /// above what a tool needs (roslibjs and Foxglove use one per topic and panel).
   static constexpr std::size_t kMaxIdsPerTopic = 32;
   static constexpr std::size_t kMaxSubscriptions = 256;
+  /// Messages one subscription holds back behind its throttle_rate at most (a larger queue_length is cut to
+  /// this). Each keeps a published message alive outside the connection's byte bound, so that uncut, a
+  /// queue_length of 10^9 with an hour's throttle_rate kept everything the simulation published (some
+  /// 0.4 MB a second in the warehouse) for as long as the connection lasted. 100 is 3 s of /tf at 30 Hz.
+  static constexpr int kMaxQueueLength = 100;
   /// The topic whose time the hub keeps for get_time (rosgraph_msgs/msg/Clock, the simulation's time).
   static constexpr const char* kClockTopic = "/clock";
 

@@ -2,6 +2,8 @@
 // RosbridgeServer over websocketpp's asio server on one I/O thread. Each connection's replies and publishes
 // wait in the hub (bounded, oldest dropped); the I/O thread hands websocketpp only as much as keeps its own
 // send buffer under kSocketBudget, so a client that stops reading costs the hub's bound plus this, never more.
+// What a client makes the server refuse or drop is logged through rfbsim::log::limited, by kind, since anyone
+// who reaches the port can cause it as often as they like; no line names the client's address.
 // Compiled as C++17 (websocketpp 0.8.2 does not build as C++20 with g++ 12).
 #include "ros/bridge/rosbridge_server.hpp"
 
@@ -16,6 +18,7 @@
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
+#include "rfbsim/log.hpp"
 #include "ros/bridge/rosbridge_session.hpp"
 
 namespace rfbsim::ros {
@@ -53,6 +56,7 @@ struct RosbridgeServer::Impl {
     std::unique_ptr<asio::steady_timer> retry;
     bool retry_armed = false;
     bool closing = false;
+    bool told_dropping = false;  // the log has heard that this connection loses messages
   };
 
   Impl(RosbridgeHub& hub_in, RosbridgeServerOptions options_in) : hub(hub_in), options(std::move(options_in)) {
@@ -132,6 +136,9 @@ struct RosbridgeServer::Impl {
       boost::system::error_code close_ec;
       if (!ec) connection->get_raw_socket().close(close_ec);
       count([](RosbridgeServerStats& s) { ++s.sockets_refused; });
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "rosbridge-sockets-refused", "ros",
+                           "rosbridge: closed a socket at accept: %zu sockets open already (4 x the %d connections)",
+                           sockets.size(), options.max_connections);
       return;
     }
     sockets.insert(hdl);
@@ -148,6 +155,9 @@ struct RosbridgeServer::Impl {
     if (admitted.size() >= static_cast<std::size_t>(options.max_connections)) {
       connection->set_status(websocketpp::http::status_code::service_unavailable);
       count([](RosbridgeServerStats& s) { ++s.refused; });
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "rosbridge-connection-limit", "ros",
+                           "rosbridge: refused a connection (503): at the limit of %d connections",
+                           options.max_connections);
       return false;
     }
     admitted.insert(hdl);
@@ -186,6 +196,15 @@ struct RosbridgeServer::Impl {
     admitted.erase(hdl);
     const auto found = peers.find(hdl);
     if (found == peers.end()) return;
+    // websocketpp's own refusal of a message far over the limit (receive() never saw it): 1009, no status.
+    websocketpp::lib::error_code ec;
+    const Endpoint::connection_ptr connection = endpoint.get_con_from_hdl(hdl, ec);
+    if (!ec && !found->second.closing &&
+        connection->get_local_close_code() == websocketpp::close::status::message_too_big) {
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "rosbridge-oversized", "ros",
+                           "rosbridge: closed a connection (1009): a message over %zu bytes, read no further",
+                           options.max_message_bytes * kHardLimitFactor + 4096);
+    }
     found->second.retry->cancel();
     hub.close_connection(found->second.hub_id);
     peers.erase(found);
@@ -208,6 +227,9 @@ struct RosbridgeServer::Impl {
       peer.closing = true;
       endpoint.close(hdl, websocketpp::close::status::message_too_big, "message too big", ec);
       count([](RosbridgeServerStats& s) { ++s.closed_oversized; });
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "rosbridge-oversized", "ros",
+                           "rosbridge: closed a connection (1009): a message of %zu bytes, over the limit of %zu",
+                           payload.size(), options.max_message_bytes);
       return;
     }
     if (message->get_opcode() == websocketpp::frame::opcode::text) {
@@ -232,6 +254,14 @@ struct RosbridgeServer::Impl {
         ec = connection->send(*frame, websocketpp::frame::opcode::text);
         if (ec) return;
       }
+    }
+    // Once per connection: the log hears that a slow reader loses its oldest messages (the hub's bound).
+    if (!peer.told_dropping && hub.dropped(peer.hub_id) > 0) {
+      peer.told_dropping = true;
+      rfbsim::log::limited(rfbsim::log::Level::kWarn, "rosbridge-slow-reader", "ros",
+                           "rosbridge: a connection reads too slowly; its oldest messages are dropped beyond %zu "
+                           "queued bytes",
+                           options.max_queued_bytes_per_connection);
     }
     // Still backlogged: websocketpp has no "drained" callback, so look again shortly.
     if (hub.has_outgoing(peer.hub_id) && !peer.retry_armed) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "ros/bridge/op_parse.hpp"
@@ -75,13 +76,13 @@ std::string id_text(const nlohmann::json& id) {
 
 void RosbridgeSession::on_text(std::string_view text) {
   text_bytes_ = text.size();
-  const ParsedOp parsed = parse_op(text);
+  ParsedOp parsed = parse_op(text);
   const nlohmann::json id = op_id(parsed.message);
   if (!parsed.error.empty()) {
     error(parsed.error, id);
     return;
   }
-  const nlohmann::json& op = parsed.message;
+  nlohmann::json& op = parsed.message;
   if (op.contains("id") && id.is_null()) {
     error("\"id\" must be a string or an integer", nullptr);
     return;
@@ -148,7 +149,7 @@ void RosbridgeSession::unadvertise(const nlohmann::json& op, const nlohmann::jso
   }
 }
 
-void RosbridgeSession::publish(const nlohmann::json& op, const nlohmann::json& id) {
+void RosbridgeSession::publish(nlohmann::json& op, const nlohmann::json& id) {
   const std::string* topic = string_field(op, "topic");
   if (topic == nullptr) return error("publish needs a string \"topic\"", id);
   const auto msg = op.find("msg");
@@ -174,7 +175,8 @@ void RosbridgeSession::publish(const nlohmann::json& op, const nlohmann::json& i
   if (!type.empty() && !contains(accepted->types, type)) {
     return error("publish: " + *topic + " takes " + join(accepted->types) + ", not " + type, id);
   }
-  hub_.push_incoming(IncomingMessage{*local, type, *msg, connection_}, text_bytes_);
+  // Moved, not copied: the frame's parse is dropped right after, and a copy would double its memory.
+  hub_.push_incoming(IncomingMessage{*local, type, std::move(*msg), connection_}, text_bytes_);
 }
 
 void RosbridgeSession::subscribe(const nlohmann::json& op, const nlohmann::json& id) {
@@ -213,6 +215,13 @@ void RosbridgeSession::subscribe(const nlohmann::json& op, const nlohmann::json&
   const SubscribeOptions options{id_text(id), throttle.value_or(0), queue_length.value_or(0)};
   const std::string refused = hub_.subscribe(connection_, *local, options);
   if (!refused.empty()) return error("subscribe: " + *topic + " refused: " + refused, id);
+  // Subscribed, with the hub's cut of the queue: said, so that a client does not count on the longer one.
+  if (options.queue_length > RosbridgeHub::kMaxQueueLength) {
+    hub_.send_status(connection_, StatusLevel::kWarning,
+                     "subscribe: queue_length " + std::to_string(options.queue_length) + " is over the limit; " +
+                         std::to_string(RosbridgeHub::kMaxQueueLength) + " is used",
+                     id);
+  }
   hub_.send_status(connection_, StatusLevel::kInfo, "subscribed to " + *topic, id);
 }
 

@@ -34,7 +34,7 @@ class RosbridgeSession {
  private:
   void advertise(const nlohmann::json& op, const nlohmann::json& id);
   void unadvertise(const nlohmann::json& op, const nlohmann::json& id);
-  void publish(const nlohmann::json& op, const nlohmann::json& id);
+  void publish(nlohmann::json& op, const nlohmann::json& id);  // takes op's "msg"
   void subscribe(const nlohmann::json& op, const nlohmann::json& id);
   void unsubscribe(const nlohmann::json& op, const nlohmann::json& id);
   void call_service(const nlohmann::json& op, const nlohmann::json& id);

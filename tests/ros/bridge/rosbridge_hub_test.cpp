@@ -160,6 +160,22 @@ TEST_CASE("throttle_rate with a queue holds the newest queue_length messages and
   CHECK(drain(f.hub, connection).at(0)["msg"] == counter(4));
 }
 
+TEST_CASE("a queue_length over kMaxQueueLength holds kMaxQueueLength messages behind the throttle") {
+  FakeClockHub f;
+  f.hub.declare("/tf", "tf2_msgs/TFMessage", false);
+  const int connection = f.hub.open_connection({});
+  // An hour's throttle with a queue of 10^9: uncut, it would keep every publish for the hour.
+  CHECK(f.hub.subscribe(connection, "/tf", SubscribeOptions{"greedy", 3'600'000, 1'000'000'000}).empty());
+  for (int n = 0; n < 1000; ++n) f.hub.publish("/tf", counter(n));  // all at t = 0
+  CHECK(drain(f.hub, connection).size() == 1);                      // 0 goes at once
+  const std::size_t held = RosbridgeHub::kMaxQueueLength;
+  CHECK(f.hub.stats().throttled_frames == 1000 - 1 - held);         // 1 .. 899 gave way
+  // The held ones come out one per throttle period, the oldest kept first.
+  f.now += milliseconds(3'600'000);
+  f.hub.flush_due();
+  CHECK(drain(f.hub, connection).at(0)["msg"] == counter(1000 - static_cast<int>(held)));
+}
+
 TEST_CASE("several subscriptions to one topic send at the lowest throttle and the longest queue") {
   FakeClockHub f;
   f.hub.declare("/odom", "nav_msgs/Odometry", false);
@@ -213,6 +229,8 @@ TEST_CASE("a connection that is not drained keeps only its newest frames within 
   const RosbridgeHubStats stats = hub.stats();
   CHECK(stats.peak_queued_bytes <= 10'000);
   CHECK(stats.dropped_frames > 990);
+  CHECK(hub.dropped(connection) == stats.dropped_frames);  // one connection: all its drops
+  CHECK(hub.dropped(connection + 1) == 0);                  // unknown
   const auto frames = drain(hub, connection);
   CHECK(frames.back()["msg"]["n"] == 999);  // the newest survive
   CHECK(frames.size() + stats.dropped_frames == 1000);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // A real RosbridgeServer on a loopback port with real WebSocket clients (TestWsClient writes the frames):
 // subscribe and publish end to end, errors that leave the connection open, an oversized message that
-// closes it, paths and connection limits, and a client that never reads.
+// closes it, paths and connection limits (and their log lines), and a client that never reads.
 #include <catch2/catch.hpp>
 
 #include <arpa/inet.h>
@@ -11,10 +11,14 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <mutex>
+#include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 #include "eventually.hpp"
+#include "rfbsim/log.hpp"
 #include "ros/bridge/rosbridge_server.hpp"
 #include "test_ws_client.hpp"
 
@@ -217,6 +221,41 @@ TEST_CASE("the WebSocket is at / only, and connections beyond the limit are refu
   }
   REQUIRE(eventually([&] { return server.stats().open == 0; }));
   CHECK(TestWsClient::handshake_status(server.port(), "/") == 101);
+}
+
+TEST_CASE("refusals a client causes are logged, rate-limited by kind, naming no address") {
+  rfbsim::log::flush_suppressed();  // counts left by earlier tests go out before the capture starts
+  std::mutex mutex;
+  std::vector<std::string> lines;
+  rfbsim::log::set_sink([&](std::string_view line) {
+    const std::lock_guard lock(mutex);
+    lines.emplace_back(line);
+  });
+  RosbridgeHub hub;
+  declare_served_topics(hub);
+  RosbridgeServerOptions options;
+  options.max_connections = 1;
+  {
+    RosbridgeServer server(hub, options);
+    TestWsClient one(server.port());
+    for (int n = 0; n < 30; ++n) CHECK(TestWsClient::handshake_status(server.port(), "/") == 503);
+  }
+  rfbsim::log::flush_suppressed();
+  rfbsim::log::set_sink({});
+
+  // Each refusal is either a line or counted in the one "suppressed" line that follows them.
+  long long written = 0;
+  long long suppressed = 0;
+  for (const std::string& line : lines) {
+    CHECK(line.find("127.0.0.1") == std::string::npos);
+    if (line.find("refused a connection (503): at the limit of 1 connections") != std::string::npos) ++written;
+    const auto at = line.find(" more like this suppressed (rosbridge-connection-limit)");
+    const auto from = line.find("] ") + 2;  // after the tag
+    if (at != std::string::npos) suppressed += std::stoll(line.substr(from, at - from));
+  }
+  CHECK(written >= 1);
+  CHECK(written <= 5);  // the log's default budget: 5 lines per kind per 10 s
+  CHECK(written + suppressed == 30);
 }
 
 TEST_CASE("a client that never reads loses its oldest messages, not the server's memory") {

@@ -254,6 +254,29 @@ TEST_CASE("a subscribe beyond the per-topic cap gets an error status naming the 
   CHECK(f.send(R"({"op":"unsubscribe","topic":"/lab/scan","id":"one too many"})").at(0)["level"] == "warning");
 }
 
+TEST_CASE("a queue_length over the hub's limit is cut with a warning, one at the limit silently") {
+  Fixture f;
+  const std::string limit = std::to_string(RosbridgeHub::kMaxQueueLength);
+  CHECK(f.send(R"({"op":"subscribe","topic":"/lab/scan","id":"a","throttle_rate":1000,"queue_length":)" + limit + "}")
+            .empty());
+  const auto warned =
+      f.send(R"({"op":"subscribe","topic":"/lab/scan","id":"b","throttle_rate":1000,"queue_length":2000000000})");
+  REQUIRE(warned.size() == 1);
+  CHECK(warned[0]["level"] == "warning");
+  CHECK(warned[0]["id"] == "b");
+  CHECK(has(warned[0]["msg"], "queue_length 2000000000 is over the limit; " + limit + " is used"));
+}
+
+TEST_CASE("a published message moves whole to the simulation: its fields, its type and its connection") {
+  Fixture f;
+  CHECK(f.send(R"({"op":"publish","topic":"/lab/cmd_vel","msg":{"linear":{"x":0.5},"angular":{"z":[1,2]}}})").empty());
+  const auto incoming = f.hub.take_incoming();
+  REQUIRE(incoming.size() == 1);
+  CHECK(incoming[0].msg == nlohmann::json({{"linear", {{"x", 0.5}}}, {"angular", {{"z", {1, 2}}}}}));
+  CHECK(incoming[0].type.empty());  // two accepted types and none named
+  CHECK(incoming[0].connection == f.connection);
+}
+
 TEST_CASE("the oversized-message status is built for sending at once, and honours the level") {
   Fixture f;
   RosbridgeSession session(f.hub, f.connection);

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// A minimal RFB 3.8 viewer for bench_ros.mjs: it makes sim_rfb render and send frames, as a participant's
-// page does, so that the bag's CPU can be set against a watched session's. It asks for Raw pixels only (the
-// one encoding that needs no decoder to skip over), reads every FramebufferUpdate to its end and asks for the
-// next at once, and counts the updates. Raw costs sim_rfb less than Tight JPEG does, so the session's CPU it
-// shows is a lower bound and the bag's share an upper one.
+// A minimal RFB 3.8 viewer for the ROS tests and bench_ros.mjs. It makes sim_rfb render and send frames, as a
+// participant's page does: the bag's CPU is set against a watched session's, and a session whose rosbridge port
+// is under attack is seen to keep streaming. It asks for Raw pixels only (the one encoding that needs no decoder
+// to skip over), reads every FramebufferUpdate to its end and asks for the next at once, and counts the updates.
+// Raw costs sim_rfb less than Tight JPEG does, so the session's CPU it shows is a lower bound and the bag's
+// share an upper one.
 
 import net from 'node:net';
 
