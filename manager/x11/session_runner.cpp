@@ -252,6 +252,10 @@ int run_session(const SessionOptions& options) {
   };
 
   // The program on that display, with the cookie; its output goes where ours goes.
+  // Where the session is, for whoever reads our output; before the program starts, which shares our stdout and
+  // would otherwise print ahead of it.
+  std::printf("display :%d\n", display);
+  std::fflush(stdout);
   pid_t program = -1;
   {
     ChildSpec spec;
@@ -268,9 +272,6 @@ int run_session(const SessionOptions& options) {
     }
   }
 
-  // Tell the manager (and whoever reads our output) where the session is.
-  std::printf("display :%d\n", display);
-  std::fflush(stdout);
   if (ready.fd >= 0) {
     const std::string lines = contract::ready_unix_line(options.rfb_socket) + contract::x11_display_line(display);
     if (!write_all(ready.fd, lines)) say(std::string("cannot write the ready lines: ") + std::strerror(errno));
