@@ -87,11 +87,14 @@ std::string stream_line(const StreamReport& report) {
   if (is_codec_name(report.codec)) line += " codec=" + report.codec;
   char rtt[32] = " rtt_ms=-1";
   if (report.rtt_ms) std::snprintf(rtt, sizeof rtt, " rtt_ms=%.1f", stream_clamped(*report.rtt_ms, 0, kMaxStreamRttMs));
-  char rest[64];
-  std::snprintf(rest, sizeof rest, " fps=%.1f quality=%d clients=%d\n",
-                stream_clamped(report.fps.value_or(0), 0, kMaxStreamFps),
-                std::clamp(report.quality.value_or(0), 0, kMaxStreamQuality), clients);
-  return line + rtt + rest;
+  char fps[32];
+  std::snprintf(fps, sizeof fps, " fps=%.1f", stream_clamped(report.fps.value_or(0), 0, kMaxStreamFps));
+  // A quality only where one applies (a lossless encoding has none).
+  char quality[32] = "";
+  if (report.quality) {
+    std::snprintf(quality, sizeof quality, " quality=%d", std::clamp(*report.quality, 0, kMaxStreamQuality));
+  }
+  return line + rtt + fps + quality + " clients=" + std::to_string(clients) + "\n";
 }
 
 bool is_stream_line(std::string_view line) {

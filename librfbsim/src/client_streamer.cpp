@@ -271,10 +271,30 @@ void ClientStreamer::count_update(TimePoint now) {
   }
 }
 
-ClientStreamStatus ClientStreamer::status(int id, TimePoint now) const {
+std::string encoding_name(std::int32_t rfb_encoding) {
+  switch (static_cast<std::uint32_t>(rfb_encoding)) {
+    case rfbEncodingRaw: return "raw";
+    case rfbEncodingRRE: return "rre";
+    case rfbEncodingCoRRE: return "corre";
+    case rfbEncodingHextile: return "hextile";
+    case rfbEncodingZlib: return "zlib";
+    case rfbEncodingTight: return "tight";
+    case rfbEncodingUltra: return "ultra";
+    case rfbEncodingTRLE: return "trle";
+    case rfbEncodingZRLE: return "zrle";
+    case rfbEncodingZYWRLE: return "zywrle";
+    case rfbEncodingTightPng: return "tightpng";
+    default: return "other";
+  }
+}
+
+ClientStreamStatus ClientStreamer::status(int id, TimePoint now, std::int32_t rfb_encoding) const {
   ClientStreamStatus s;
   s.id = id;
-  s.encoding = h264_ ? "h264" : "tight";
+  // What the client really gets: a client that asked for ZRLE only is sent ZRLE, not Tight.
+  s.encoding = h264_ ? "h264" : encoding_name(rfb_encoding);
+  // A quality only where one applies: Tight's JPEG, and H.264's configured level; none for the lossless ones.
+  const bool has_quality = h264_ || static_cast<std::uint32_t>(rfb_encoding) == rfbEncodingTight;
   s.continuous_updates = protocol_.continuous;
   s.fence = protocol_.offers_fence;
   if (const auto base = congestion_.base_rtt()) s.base_rtt_ms = static_cast<double>(base->count()) / 1000.0;
@@ -284,9 +304,10 @@ ClientStreamStatus ClientStreamer::status(int id, TimePoint now) const {
   s.updates_sent = updates_sent_;
   s.updates_held = updates_held_;
   s.update_requests = protocol_.update_requests;
-  const auto level = tight_quality();
+  const auto level = has_quality ? tight_quality() : std::nullopt;
   s.quality = level ? level->jpeg_quality : 0;
-  s.quality_level = protocol_.continuous && config_.adaptive_quality ? static_cast<int>(quality_.level()) : 0;
+  s.quality_level =
+      has_quality && protocol_.continuous && config_.adaptive_quality ? static_cast<int>(quality_.level()) : 0;
   s.delivery_mbit = congestion_.path_rate() * 8.0 / 1e6;
   // An fps that stopped being refreshed (no updates for a while) is stale: age it out.
   s.fps = now - rate_window_start_ > std::chrono::seconds(2) ? 0.0 : fps_;

@@ -69,7 +69,9 @@ class ClientStreamer {
   /// Counts bytes written by a Tight update (from the server's update hooks) into the stream position.
   void tight_update_written(TimePoint now, std::uint64_t bytes);
   /// A snapshot for status pages.
-  [[nodiscard]] ClientStreamStatus status(int id, TimePoint now) const;
+  /// `rfb_encoding`: the encoding libvncserver sends this client's updates in (rfbClientRec::preferredEncoding,
+  /// the first of the client's SetEncodings it supports); named as it is unless H.264 took over.
+  [[nodiscard]] ClientStreamStatus status(int id, TimePoint now, std::int32_t rfb_encoding) const;
 
  private:
   bool use_h264();
@@ -94,5 +96,9 @@ class ClientStreamer {
   std::uint64_t rate_window_updates_ = 0;
   double fps_ = 0;
 };
+
+/// An RFB encoding's name as status pages show it: "tight", "zrle", "hextile", "raw", "zlib", "trle", "zywrle",
+/// "rre", "corre", "ultra", "tightpng"; "other" for one this list lacks.
+std::string encoding_name(std::int32_t rfb_encoding);
 
 }  // namespace rfbsim::detail

@@ -388,7 +388,7 @@ void Server::Impl::publish_streams(Clock::time_point now) {
   std::vector<ClientStreamStatus> fresh;
   for (rfbClientPtr cl = screen->clientHead; cl != nullptr; cl = cl->next) {
     if (const auto* state = static_cast<const ClientState*>(cl->clientData)) {
-      fresh.push_back(state->streamer.status(state->info.id, now));
+      fresh.push_back(state->streamer.status(state->info.id, now, cl->preferredEncoding));
     }
   }
   const std::lock_guard lock(streams_mutex);

@@ -152,7 +152,7 @@ std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions
       out += "rfbsim_session_fps{" + session_label(s) + "} " + number(*s.report.fps) + "\n";
     }
   }
-  header(out, "rfbsim_session_codec_info", "gauge", "The encoding of the session's picture stream (tight or h264): 1.");
+  header(out, "rfbsim_session_codec_info", "gauge", "The encoding of the session's picture stream (tight, h264, zrle, hextile, raw ...): 1.");
   for (const SessionStream& s : streams) {
     if (s.report.clients > 0 && !s.report.codec.empty()) {
       out += "rfbsim_session_codec_info{" + session_label(s) + ",codec=\"" + label_value(s.report.codec) + "\"} 1\n";

@@ -53,8 +53,11 @@ std::string streams_json(const std::vector<rfbsim::ClientStreamStatus>& streams)
             ",\"in_flight_bytes\":" + std::to_string(s.in_flight_bytes) +
             ",\"updates_sent\":" + std::to_string(s.updates_sent) +
             ",\"updates_held\":" + std::to_string(s.updates_held) +
-            ",\"update_requests\":" + std::to_string(s.update_requests) + ",\"quality\":" + std::to_string(s.quality) +
-            ",\"quality_level\":" + std::to_string(s.quality_level) +
+            ",\"update_requests\":" + std::to_string(s.update_requests) +
+            // A quality only where one applies (Tight's JPEG, H.264): ZRLE, Hextile and Raw are lossless.
+            (s.quality > 0 ? ",\"quality\":" + std::to_string(s.quality) +
+                                 ",\"quality_level\":" + std::to_string(s.quality_level)
+                           : std::string()) +
             ",\"delivery_mbit\":" + json_number(s.delivery_mbit, 2) + ",\"fps\":" + json_number(s.fps, 1) + "}";
   }
   return json + "]";
@@ -69,7 +72,7 @@ std::string stream_line(const std::vector<rfbsim::ClientStreamStatus>& streams) 
   report.codec = participant->encoding;
   if (participant->last_rtt_ms >= 0) report.rtt_ms = participant->last_rtt_ms;  // the library says -1 until measured
   report.fps = participant->fps;
-  report.quality = participant->quality;
+  if (participant->quality > 0) report.quality = participant->quality;
   return contract::stream_line(report);
 }
 

@@ -127,12 +127,15 @@ TEST_CASE("the writer gives sim_rfb's exact bytes") {
   CHECK(stream_line(StreamReport{2, "", std::nullopt, 0.0, 60}) == "stream rtt_ms=-1 fps=0.0 quality=60 clients=2\n");
   CHECK(stream_line(StreamReport{123456, "Not A Codec", 1e12, 1.0 / 0.0, 500}) ==
         "stream rtt_ms=600000.0 fps=0.0 quality=100 clients=9999\n");
+  // A lossless encoding has no quality: the key is left out rather than written as 0.
+  CHECK(stream_line(StreamReport{1, "zrle", 3.0, 15.0, std::nullopt}) == "stream codec=zrle rtt_ms=3.0 fps=15.0 clients=1\n");
 }
 
 TEST_CASE("what the writer writes reads back as it was") {
   using rfbsim::contract::StreamReport;
   for (const StreamReport& written : {StreamReport{1, "h264", 52.3, 29.7, 80}, StreamReport{3, "", std::nullopt, 0.5, 1},
-                                      StreamReport{9999, "tight", 0.0, 1000.0, 100}}) {
+                                      StreamReport{9999, "tight", 0.0, 1000.0, 100},
+                                      StreamReport{1, "zrle", 2.5, 15.0, std::nullopt}}) {
     std::string line = rfbsim::contract::stream_line(written);
     REQUIRE(line.back() == '\n');
     line.pop_back();

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <thread>
 
+#include "raw_socket.hpp"
 #include "rfb_test_client.hpp"
 #include "rfbsim/server.hpp"
 #include "sim_process.hpp"
@@ -287,6 +288,39 @@ TEST_CASE("/status.json lists each viewer's stream: encoding, ContinuousUpdates,
     CHECK(json_number(streams, "base_rtt_ms") >= 0);
     CHECK(client.fences_answered() > 0);
   }
+}
+
+TEST_CASE("/status.json names the encoding a client really gets: ZRLE for one that asks for ZRLE only, no quality") {
+  SimProcess sim(rfbsim::test::sim_rfb_path(), kSmall);
+  // A raw RFB 3.8 client: security None, a shared ClientInit, then SetEncodings with ZRLE (16) alone and one
+  // full update request.
+  rfbsim::test::RawSocket client(sim.port());
+  REQUIRE(client.read_until("\n", 10s).rfind("RFB 003.00", 0) == 0);
+  REQUIRE(client.send_all(std::string("RFB 003.008\n")));
+  std::vector<std::uint8_t> bytes;
+  REQUIRE(client.read_exact(1, bytes, 10s));
+  REQUIRE(client.read_exact(bytes[0], bytes, 10s));  // the security types
+  REQUIRE(client.send_all(std::vector<std::uint8_t>{1}));
+  REQUIRE(client.read_exact(4, bytes, 10s));  // SecurityResult: OK
+  REQUIRE(client.send_all(std::vector<std::uint8_t>{1}));
+  REQUIRE(client.read_exact(24, bytes, 10s));  // ServerInit up to the name's length
+  const std::uint32_t name_length = (std::uint32_t{bytes[20]} << 24) | (std::uint32_t{bytes[21]} << 16) |
+                                    (std::uint32_t{bytes[22]} << 8) | std::uint32_t{bytes[23]};
+  REQUIRE(client.read_exact(name_length, bytes, 10s));
+  REQUIRE(client.send_all(std::vector<std::uint8_t>{2, 0, 0, 1, 0, 0, 0, 16}));  // SetEncodings: [ZRLE]
+  REQUIRE(client.send_all(std::vector<std::uint8_t>{3, 0, 0, 0, 0, 0, 0x01, 0x40, 0, 0xf0}));  // 320x240, full
+  std::string status;
+  REQUIRE(await_status(sim, nullptr, [](const std::string& s) {
+    return stream_count(streams_of(s)) == 1 && json_number(streams_of(s), "updates_sent") >= 1;
+  }, status));
+  const std::string streams = streams_of(status);
+  INFO(streams);
+  CHECK_THAT(streams, Catch::Contains(R"("encoding":"zrle")"));
+  CHECK(streams.find("\"quality\"") == std::string::npos);  // ZRLE is lossless: no JPEG quality applies
+  // The update it got is ZRLE indeed: a FramebufferUpdate whose first rectangle is encoded 16.
+  REQUIRE(client.read_exact(16, bytes, 10s));
+  CHECK(bytes[0] == 0);  // FramebufferUpdate
+  CHECK(((bytes[12] << 24) | (bytes[13] << 16) | (bytes[14] << 8) | bytes[15]) == 16);
 }
 
 TEST_CASE("a client that leaves with W held does not leave the avatar walking") {

@@ -7,10 +7,12 @@
 //   stream clients=0
 //
 // Space-separated key=value pairs after the word "stream", in this order:
-//   codec    "tight" or "h264" (1..16 lower-case letters and digits; left out when the server names none)
+//   codec    what the participant gets: "tight", "zrle", "hextile", "raw", "h264", ... (1..16 lower-case letters
+//            and digits; left out when the server names none)
 //   rtt_ms   the latest round trip measured with fences, ms, one decimal; -1 while none was measured
 //   fps      updates per second over about the last second, one decimal
-//   quality  the JPEG quality in use 1..100 (Tight), or the configured one (H.264)
+//   quality  the JPEG quality in use 1..100 (Tight), or the configured one (H.264); left out where none
+//            applies (ZRLE, Hextile, Raw and the other lossless encodings)
 //   clients  how many viewers are connected; with 0 no other key follows
 // Readers ignore keys they do not know: later versions may add some. docs/deployment.md describes it too.
 #pragma once
@@ -33,7 +35,7 @@ struct StreamReport {
   std::string codec;              ///< "tight", "h264", ... (see is_codec_name); "" = not said
   std::optional<double> rtt_ms;   ///< the latest round trip, ms (0..600000); unset = not measured (-1 on the line)
   std::optional<double> fps;      ///< updates per second over about the last second (0..1000)
-  std::optional<int> quality;     ///< JPEG quality in use (0..100)
+  std::optional<int> quality;     ///< JPEG quality in use (0..100); unset where none applies (ZRLE, Raw ...)
 };
 
 /// The outcome of parsing a line: a report, or what is wrong with it.

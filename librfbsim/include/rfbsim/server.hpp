@@ -40,7 +40,7 @@ enum class Codec : std::uint8_t {
 /// One client's stream as the server sees it now, for status pages.
 struct ClientStreamStatus {
   int id = 0;                       ///< ClientInfo::id
-  std::string encoding;             ///< "tight" or "h264"
+  std::string encoding;             ///< what the client gets: "tight", "zrle", "hextile", "raw", "h264", ...
   bool continuous_updates = false;  ///< updates pushed (ContinuousUpdates) rather than requested
   bool fence = false;               ///< the client answers fences (congestion control is possible)
   double base_rtt_ms = -1;          ///< lowest round trip seen through fences; -1 = not measured yet
@@ -50,7 +50,7 @@ struct ClientStreamStatus {
   std::uint64_t updates_sent = 0;   ///< framebuffer updates sent to this client
   std::uint64_t updates_held = 0;   ///< new frames held back because the link was full (they coalesce)
   std::uint64_t update_requests = 0;  ///< FramebufferUpdateRequests received (few once continuous)
-  int quality = 0;                  ///< JPEG quality in use (Tight), or the configured one (H.264)
+  int quality = 0;                  ///< JPEG quality in use (Tight), or the configured one (H.264); 0 = none applies
   int quality_level = 0;            ///< 0 = the configured quality; each step down is one more
   double delivery_mbit = 0;         ///< the link's measured rate while full, Mbit/s; 0 = unknown
   double fps = 0;                   ///< updates per second over the last second or so
