@@ -59,6 +59,8 @@ std::optional<std::string> normalize_topic(std::string_view topic) {
   return "/" + std::string(relative);
 }
 
+std::optional<std::string> normalize_service(std::string_view service) { return normalize_topic(service); }
+
 std::optional<std::string> normalize_namespace(std::string_view ns) {
   if (ns.empty()) return std::string();
   if (ns.front() != '/') return std::nullopt;

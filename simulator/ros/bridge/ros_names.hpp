@@ -22,6 +22,10 @@ std::string short_ros_type(std::string_view type);
 /// ROS identifiers (letters, digits, '_'; not starting with a digit); nullopt when malformed.
 std::optional<std::string> normalize_topic(std::string_view topic);
 
+/// A service name made absolute, by the same rules as topics: "rosapi/topics" (as roslibjs's Ros helpers write
+/// it) -> "/rosapi/topics"; nullopt when malformed.
+std::optional<std::string> normalize_service(std::string_view service);
+
 /// A topic namespace as given to RosbridgeHub: "" stays "", "/rfbsim/s1/" -> "/rfbsim/s1"; nullopt when it is
 /// not "" and not a valid absolute topic name.
 std::optional<std::string> normalize_namespace(std::string_view ns);

@@ -2,11 +2,14 @@
 // call_rosapi: each answer has the fields of rosbridge_suite's rosapi_msgs service definitions
 // (rosapi_msgs/srv/Topics.srv: topics, types; TopicsAndRawTypes.srv: topics, types, typedefs_full_text;
 // GetROSVersion.srv: version, distro; GetTime.srv: time; Nodes.srv: nodes; Services.srv: services;
-// TopicType.srv: topic -> type; Publishers.srv: topic -> publishers; Subscribers.srv: topic -> subscribers).
+// TopicType.srv: topic -> type; Publishers.srv: topic -> publishers; Subscribers.srv: topic -> subscribers;
+// MessageDetails.srv: type -> typedefs).
 // As rosapi does, a topic nobody knows gets an empty answer (type "", no publishers), not a failure.
 #include "ros/bridge/rosapi_services.hpp"
 
 #include <algorithm>
+
+#include "ros/bridge/ros2msg_typedefs.hpp"
 
 namespace rfbsim::ros {
 
@@ -59,6 +62,25 @@ std::optional<ListedTopic> find_topic(const RosbridgeHub& hub, const std::string
 
 RosapiAnswer ok(json values) { return {true, std::move(values)}; }
 
+// message_details: the TypeDefs of a type the simulation has a definition of (its topics' types), parsed from
+// the same text topics_and_raw_types hands out. Unlike a topic, an unknown type fails: an empty list would
+// leave roslibjs's decodeTypeDefs nothing to read.
+RosapiAnswer message_details(const RosbridgeHub& hub, const json& args) {
+  const json* type = nullptr;
+  if (args.is_object() && args.contains("type")) type = &args["type"];
+  if (args.is_array() && args.size() == 1) type = &args[0];
+  if (type == nullptr || !type->is_string()) {
+    return {false, "/rosapi/message_details needs a string \"type\" in \"args\""};
+  }
+  const std::string normalized = normalize_ros_type(type->get<std::string>());
+  json typedefs = normalized.empty() ? json::array() : ros2msg_typedefs(normalized, hub.definition(normalized));
+  if (typedefs.empty()) {
+    return {false, "/rosapi/message_details: no definition of '" + type->get<std::string>() +
+                       "'; rfbsim knows its topics' types (rosapi/topics_and_raw_types)"};
+  }
+  return ok({{"typedefs", std::move(typedefs)}});
+}
+
 RosapiAnswer topic_list(const RosbridgeHub& hub, bool with_definitions) {
   json names = json::array();
   json types = json::array();
@@ -91,7 +113,8 @@ RosapiAnswer about_topic(const RosbridgeHub& hub, std::string_view service, cons
 const std::vector<std::string>& rosapi_services() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> sorted = {"/rosapi/get_ros_version", "/rosapi/get_time",
-                                       "/rosapi/nodes",           "/rosapi/publishers",
+                                       "/rosapi/message_details", "/rosapi/nodes",
+                                       "/rosapi/publishers",
                                        "/rosapi/services",        "/rosapi/subscribers",
                                        "/rosapi/topic_type",      "/rosapi/topics",
                                        "/rosapi/topics_and_raw_types"};
@@ -118,6 +141,7 @@ std::optional<RosapiAnswer> call_rosapi(const RosbridgeHub& hub, std::string_vie
   }
   if (service == "/rosapi/nodes") return ok({{"nodes", json::array({kRosapiNodeName})}});
   if (service == "/rosapi/services") return ok({{"services", names}});
+  if (service == "/rosapi/message_details") return message_details(hub, args);
   return about_topic(hub, service, args);
 }
 

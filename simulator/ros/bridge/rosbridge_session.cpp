@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "ros/bridge/op_parse.hpp"
+#include "ros/bridge/ros_names.hpp"
 #include "ros/bridge/rosapi_services.hpp"
 
 namespace rfbsim::ros {
@@ -21,7 +22,7 @@ namespace {
 // Ops of the protocol that rfbsim does not offer: a clear "not supported" rather than "unknown".
 bool is_unsupported_op(const std::string& op) {
   for (const char* name : {"fragment", "png", "advertise_service", "unadvertise_service", "service_response",
-                           "advertise_action", "unadvertise_action", "send_action_goal", "cancel_action_goal",
+                           "advertise_action", "unadvertise_action", "cancel_action_goal",
                            "action_feedback", "action_result"}) {
     if (op == name) return true;
   }
@@ -67,6 +68,9 @@ bool contains(const std::vector<std::string>& items, const std::string& item) {
   return false;
 }
 
+// action_msgs/msg/GoalStatus STATUS_ABORTED.
+constexpr int kGoalStatusAborted = 6;
+
 std::string id_text(const nlohmann::json& id) {
   if (id.is_string()) return id.get<std::string>();
   return id.is_null() ? "" : id.dump();
@@ -100,6 +104,8 @@ void RosbridgeSession::on_text(std::string_view text) {
     unsubscribe(op, id);
   } else if (name == "call_service") {
     call_service(op, id);
+  } else if (name == "send_action_goal") {
+    send_action_goal(op, id);
   } else if (name == "set_level") {
     set_level(op, id);
   } else if (name == "status") {
@@ -238,13 +244,33 @@ void RosbridgeSession::call_service(const nlohmann::json& op, const nlohmann::js
   const std::string* service = string_field(op, "service");
   if (service == nullptr) return error("call_service needs a string \"service\"", id);
   const auto args = op.find("args");
-  std::optional<RosapiAnswer> answer = call_rosapi(hub_, *service, args == op.end() ? nlohmann::json() : *args);
+  // The one place a service name is made absolute: roslibjs's Ros helpers call "rosapi/topics", other clients
+  // "/rosapi/topics", and both mean the same service.
+  const std::optional<std::string> name = normalize_service(*service);
+  std::optional<RosapiAnswer> answer;
+  if (name) answer = call_rosapi(hub_, *name, args == op.end() ? nlohmann::json() : *args);
   // Any other service: a failed response rather than silence, so that the caller does not wait.
   if (!answer) answer = RosapiAnswer{false, "rfbsim offers no service '" + *service + "', only rosapi's discovery"};
+  // "service" echoes the name as the client wrote it, as rosbridge_server does.
   nlohmann::json response = {{"op", "service_response"}, {"service", *service}, {"result", answer->result},
                              {"values", std::move(answer->values)}};
   if (!id.is_null()) response["id"] = id;
   hub_.send(connection_, response.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+}
+
+void RosbridgeSession::send_action_goal(const nlohmann::json& op, const nlohmann::json& id) {
+  // A failed action_result, which roslibjs's Action.sendGoal hands to its failed callback at once (a status
+  // message it never surfaces, and the caller would wait forever). status 6 is action_msgs/GoalStatus's
+  // STATUS_ABORTED: the goal ends without running.
+  const std::string* action = string_field(op, "action");
+  const std::string why = "rfbsim offers no actions" + (action == nullptr ? "" : ", not '" + *action + "'");
+  nlohmann::json result = {{"op", "action_result"},
+                           {"action", action == nullptr ? nlohmann::json() : nlohmann::json(*action)},
+                           {"values", why},
+                           {"status", kGoalStatusAborted},
+                           {"result", false}};
+  if (!id.is_null()) result["id"] = id;
+  hub_.send(connection_, result.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 void RosbridgeSession::set_level(const nlohmann::json& op, const nlohmann::json& id) {

@@ -2,7 +2,9 @@
 // RosbridgeSession: the rosbridge v2 server side of one client connection, as pure protocol: it reads the
 // client's ops (advertise, unadvertise, publish, subscribe, unsubscribe, call_service, set_level) and turns
 // them into hub subscriptions, incoming messages and replies queued on the hub; call_service answers rosapi's
-// discovery services (ros/bridge/rosapi_services.hpp). It never touches a socket:
+// discovery services (ros/bridge/rosapi_services.hpp), with or without the leading slash, and any other service
+// with a failed service_response; send_action_goal gets a failed action_result, as client libraries (roslibjs's
+// Action.sendGoal) surface only those. It never touches a socket:
 // RosbridgeServer moves its bytes. Bad input of any kind gets an error status and the connection stays open.
 #pragma once
 
@@ -38,6 +40,7 @@ class RosbridgeSession {
   void subscribe(const nlohmann::json& op, const nlohmann::json& id);
   void unsubscribe(const nlohmann::json& op, const nlohmann::json& id);
   void call_service(const nlohmann::json& op, const nlohmann::json& id);
+  void send_action_goal(const nlohmann::json& op, const nlohmann::json& id);  // a failed action_result
   void set_level(const nlohmann::json& op, const nlohmann::json& id);
   void error(const std::string& text, const nlohmann::json& id);
 

@@ -82,12 +82,32 @@ TEST_CASE("rosapi get_ros_version, nodes and services describe rfbsim's ROS 2 se
   CHECK(version["distro"] == "humble");
   CHECK(s.values("/rosapi/nodes")["nodes"] == nlohmann::json({"/rfbsim"}));
   const nlohmann::json services = s.values("/rosapi/services")["services"];
-  CHECK(services.size() == 9);
+  CHECK(services.size() == 10);
   for (const char* name : {"/rosapi/topics", "/rosapi/topics_and_raw_types", "/rosapi/get_ros_version",
                                   "/rosapi/get_time", "/rosapi/nodes", "/rosapi/services", "/rosapi/topic_type",
-                                  "/rosapi/publishers", "/rosapi/subscribers"}) {
+                                  "/rosapi/publishers", "/rosapi/subscribers", "/rosapi/message_details"}) {
     CHECK(std::find(services.begin(), services.end(), name) != services.end());
   }
+}
+
+TEST_CASE("rosapi message_details parses a topic type's definition into TypeDefs, and fails for others") {
+  Served s;
+  // Either spelling, an args object or rosbridge's positional list, and roslibjs's relative service name.
+  for (const nlohmann::json& args : {nlohmann::json({{"type", "geometry_msgs/Twist"}}),
+                                     nlohmann::json::array({"geometry_msgs/msg/Twist"})}) {
+    const nlohmann::json typedefs = s.values("rosapi/message_details", args)["typedefs"];
+    REQUIRE(typedefs.size() == 1);
+    CHECK(typedefs[0]["type"] == "geometry_msgs/msg/Twist");
+    CHECK(typedefs[0]["fieldnames"] == nlohmann::json({"linear", "angular"}));
+    CHECK(typedefs[0]["fieldtypes"] == nlohmann::json({"geometry_msgs/msg/Vector3", "geometry_msgs/msg/Vector3"}));
+    CHECK(typedefs[0]["fieldarraylen"] == nlohmann::json({-1, -1}));
+  }
+  for (const char* type : {"nav_msgs/msg/OccupancyGrid", "geometry_msgs/msg/Vector3", "nonsense"}) {
+    const nlohmann::json failed = s.call("/rosapi/message_details", {{"type", type}});
+    CHECK(failed["result"] == false);
+    CHECK(failed["values"].get<std::string>().find(type) != std::string::npos);
+  }
+  CHECK(s.call("/rosapi/message_details", nlohmann::json::object())["result"] == false);
 }
 
 TEST_CASE("rosapi get_time answers the latest /clock the simulation published, zero before any") {

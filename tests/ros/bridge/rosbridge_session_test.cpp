@@ -185,6 +185,42 @@ TEST_CASE("call_service answers rosapi from the hub and any other service with a
   CHECK(positional.at(0)["values"]["type"] == "nav_msgs/msg/OccupancyGrid");
 }
 
+TEST_CASE("call_service finds rosapi with or without the leading slash, as roslibjs's helpers call it") {
+  Fixture f;
+  const auto relative = f.send(R"({"op":"call_service","id":"r","service":"rosapi/nodes","args":{}})");
+  REQUIRE(relative.size() == 1);
+  CHECK(relative[0]["result"] == true);
+  CHECK(relative[0]["service"] == "rosapi/nodes");  // echoed as the client wrote it
+  CHECK(relative[0]["values"]["nodes"] == nlohmann::json({"/rfbsim"}));
+  const auto type =
+      f.send(R"({"op":"call_service","id":"t","service":"rosapi/topic_type","args":{"topic":"/lab/map"}})");
+  CHECK(type.at(0)["values"]["type"] == "nav_msgs/msg/OccupancyGrid");
+  // A malformed or unknown name, relative or not, still gets a failed response naming it.
+  for (const char* name : {"rosapi/get_param", "rosapi//topics", "", "rosapi/topics/"}) {
+    const auto failed = f.send(nlohmann::json({{"op", "call_service"}, {"id", "x"}, {"service", name}}).dump());
+    REQUIRE(failed.size() == 1);
+    CHECK(failed[0]["op"] == "service_response");
+    CHECK(failed[0]["result"] == false);
+    CHECK(failed[0]["id"] == "x");
+  }
+}
+
+TEST_CASE("send_action_goal gets a failed action_result at once, with the goal's id and the reason") {
+  Fixture f;
+  const auto frames = f.send(R"({"op":"send_action_goal","id":"g1","action":"/navigate_to_pose",)"
+                             R"("action_type":"nav2_msgs/NavigateToPose","args":{},"feedback":true})");
+  REQUIRE(frames.size() == 1);
+  CHECK(frames[0]["op"] == "action_result");
+  CHECK(frames[0]["id"] == "g1");
+  CHECK(frames[0]["action"] == "/navigate_to_pose");
+  CHECK(frames[0]["result"] == false);
+  CHECK(frames[0]["status"] == 6);  // action_msgs/GoalStatus STATUS_ABORTED
+  CHECK(has(frames[0]["values"].get<std::string>(), "/navigate_to_pose"));
+  // Without an action or an id it still answers, and the connection stays usable.
+  CHECK(f.send(R"({"op":"send_action_goal"})").at(0)["result"] == false);
+  CHECK(has(f.error_for(R"({"op":"cancel_action_goal","id":"g1"})"), "not supported"));
+}
+
 TEST_CASE("set_level changes which status messages come back") {
   Fixture f;
   CHECK(f.send(R"({"op":"set_level","level":"info"})").empty());
