@@ -22,11 +22,14 @@ using config_table::settings;
 const std::map<std::string, std::string> kRepeatedFlags = {{"session_args", "--session-arg"},
                                                             {"after_session_command", "--after-session-command"}};
 
-// Markdown's `code` as a terminal shows it.
-std::string plain(std::string text) {
-  text.erase(std::remove(text.begin(), text.end(), '`'), text.end());
-  return text;
-}
+// The secrets the environment may give, and where each goes.
+struct SecretSource {
+  const char* key;
+  const char* variable;
+  std::string ManagerConfig::*field;
+};
+const SecretSource kSecretSources[] = {{"admin_token", "RFBSIM_ADMIN_TOKEN", &ManagerConfig::admin_token},
+                                       {"link_secret", "RFBSIM_LINK_SECRET", &ManagerConfig::link_secret}};
 
 // What the command line gave, before any of it is checked.
 struct Given {
@@ -54,14 +57,14 @@ void declare(CLI::App& app, Given& given) {
                "print the effective settings (defaults, file, flags and environment) as a config file and exit");
   const ManagerConfig defaults;
   for (const config_table::Setting& setting : settings()) {
-    std::string help = plain(setting.help);
+    std::string help = config_table::plain_text(setting.help);
     const auto shown = setting.kind.show(defaults);
     std::string default_text;
     if (shown && !shown->empty()) {
       for (const std::string& value : *shown) default_text += (default_text.empty() ? "" : ",") + value;
     }
-    if (!setting.default_note.empty()) {
-      default_text = default_text.empty() ? plain(setting.default_note) : default_text + "; " + plain(setting.default_note);
+    if (const std::string note = config_table::plain_text(setting.default_note); !note.empty()) {
+      default_text = default_text.empty() ? note : default_text + "; " + note;
     }
     const std::string type = setting.kind.value_name + (setting.kind.range.empty() ? "" : ":" + setting.kind.range);
     CLI::Option* option = nullptr;
@@ -125,28 +128,24 @@ ConfigOutcome parse_manager_args(const std::vector<std::string>& args,
       return outcome;
     }
   }
-  // Secrets from the environment (e.g. a systemd EnvironmentFile) keep them out of `ps`. They fill a secret the
-  // flags and files left empty, or one a printed config left as a placeholder.
-  for (const auto& [name, value] : environment) {
-    const std::string key =
-        name == "RFBSIM_ADMIN_TOKEN" ? "admin_token" : name == "RFBSIM_LINK_SECRET" ? "link_secret" : "";
-    if (key.empty()) continue;
-    std::string& field = key == "admin_token" ? outcome.config.admin_token : outcome.config.link_secret;
-    if (!field.empty() && field != config_table::kSecretPlaceholder) continue;
-    const std::string problem = find_setting(key)->kind.apply(outcome.config, {value});
-    if (!problem.empty() || field == config_table::kSecretPlaceholder) {
-      outcome.error = name + ": " + (problem.empty() ? "must be the secret itself, not " + field : problem);
-      return outcome;
+  for (const SecretSource& secret : kSecretSources) {
+    std::string& field = outcome.config.*secret.field;
+    // The environment (e.g. a systemd EnvironmentFile) keeps a secret out of `ps`. It fills a secret the flags
+    // and files left empty, or one a printed config left as a placeholder.
+    const auto given_value = std::find_if(environment.begin(), environment.end(),
+                                          [&](const auto& variable) { return variable.first == secret.variable; });
+    if (given_value != environment.end() && (field.empty() || field == config_table::kSecretPlaceholder)) {
+      const std::string problem = find_setting(secret.key)->kind.apply(outcome.config, {given_value->second});
+      if (!problem.empty() || field == config_table::kSecretPlaceholder) {
+        outcome.error = std::string(secret.variable) + ": " +
+                        (problem.empty() ? "must be the secret itself, not " + field : problem);
+        return outcome;
+      }
     }
-  }
-  // A printed config stands for its secrets with a placeholder: printing it again is fine, serving is not.
-  for (const char* key : {"admin_token", "link_secret"}) {
-    const std::string& field = std::string(key) == "admin_token" ? outcome.config.admin_token : outcome.config.link_secret;
+    // A printed config stands for its secrets with a placeholder: printing it again is fine, serving is not.
     if (field == config_table::kSecretPlaceholder && !given.print_config) {
-      std::string variable = std::string("RFBSIM_") + key;
-      std::transform(variable.begin(), variable.end(), variable.begin(), ::toupper);
-      outcome.error = std::string(key) + " is " + field + " (as --print-config writes it): give the secret itself by " +
-                      config_table::flag_of(key) + ", the file or " + variable;
+      outcome.error = std::string(secret.key) + " is " + field + " (as --print-config writes it): give the secret " +
+                      "itself by " + config_table::flag_of(secret.key) + ", the file or " + secret.variable;
       return outcome;
     }
   }

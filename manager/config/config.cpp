@@ -63,12 +63,9 @@ namespace {
 // a key that is not a section.
 std::vector<std::string> section_names(const std::string& section) {
   std::vector<std::string> names;
-  if (std::find(config_table::kSections.begin(), config_table::kSections.end(), section) ==
-      config_table::kSections.end()) {
-    return names;
-  }
+  if (section.empty()) return names;  // "" names no section (top-level keys have section "")
   for (const config_table::Setting& setting : config_table::settings()) {
-    if (setting.key.rfind(section + "_", 0) == 0) names.push_back(setting.key.substr(section.size() + 1));
+    if (config_table::section_of(setting.key) == section) names.push_back(setting.key.substr(section.size() + 1));
   }
   return names;
 }

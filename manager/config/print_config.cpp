@@ -3,7 +3,6 @@
 // reading back of each setting (settings_table.hpp). Written so that reading it back prints it again unchanged:
 // an unset setting, whose default depends on others (max_duration_s, fitted to the tasks), stays unset as a
 // comment rather than pinned to today's value.
-#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -45,19 +44,6 @@ std::string yaml_scalar(const std::string& text) {
   return quoted + "\"";
 }
 
-std::string without_backticks(std::string text) {
-  text.erase(std::remove(text.begin(), text.end(), '`'), text.end());
-  return text;
-}
-
-// The section a key belongs to ("ros" for ros_connect), or "".
-std::string section_of(const std::string& key) {
-  for (const std::string& section : config_table::kSections) {
-    if (key.rfind(section + "_", 0) == 0) return section;
-  }
-  return {};
-}
-
 }  // namespace
 
 std::string print_config(const ManagerConfig& config) {
@@ -67,21 +53,22 @@ std::string print_config(const ManagerConfig& config) {
       "# environment or a flag where this file is used.\n";
   std::string open_section;
   for (const config_table::Setting& setting : config_table::settings()) {
-    const std::string section = section_of(setting.key);
+    const std::string section = config_table::section_of(setting.key);
     const std::string name = section.empty() ? setting.key : setting.key.substr(section.size() + 1);
     const std::string indent = section.empty() ? "" : "  ";
     if (section != open_section && !section.empty()) {
       // A section of comments only is written as an empty mapping, which the reader takes.
       bool any_set = false;
       for (const config_table::Setting& other : config_table::settings()) {
-        any_set = any_set || (section_of(other.key) == section && other.kind.show(config).has_value());
+        any_set = any_set || (config_table::section_of(other.key) == section && other.kind.show(config).has_value());
       }
       out += section + (any_set ? ":\n" : ": {}\n");
     }
     open_section = section;
     const auto shown = setting.kind.show(config);
     if (!shown) {
-      out += indent + "# " + name + ":" + (setting.default_note.empty() ? "" : " (unset: " + without_backticks(setting.default_note) + ")");
+      const std::string note = config_table::plain_text(setting.default_note);
+      out += indent + "# " + name + ":" + (note.empty() ? "" : " (unset: " + note + ")");
       out += "\n";
     } else if (!setting.kind.list) {
       out += indent + name + ": " + yaml_scalar(shown->empty() ? std::string() : shown->front()) + "\n";

@@ -60,20 +60,6 @@ std::optional<ClusterPeer> parse_cluster_peer(const std::string& entry) {
 
 }  // namespace
 
-std::string spoken_list(const std::vector<std::string>& names) {
-  std::string spoken;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    spoken += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
-  }
-  return spoken;
-}
-
-std::string bar_list(const std::vector<std::string>& names) {
-  std::string joined;
-  for (std::size_t i = 0; i < names.size(); ++i) joined += (i == 0 ? "" : "|") + names[i];
-  return joined;
-}
-
 ValueKind integer(int ManagerConfig::*field, int low, int high) {
   const std::string range = std::to_string(low) + ".." + std::to_string(high);
   return {"N", range, false,

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "cli/command_line.hpp"
 #include "config/settings_table.hpp"
 
 namespace rfbsim::manager::config_table {
@@ -72,11 +73,9 @@ ValueKind ros_choice(std::string RosSettings::*field, const std::vector<std::str
 ValueKind limit_count(std::uint64_t ProcessLimits::*field, std::uint64_t high, std::string value_name,
                       const std::string& what);
 
-/// "a, b or c" for names {a, b, c}.
-std::string spoken_list(const std::vector<std::string>& names);
-
-/// "a|b|c" for names {a, b, c}.
-std::string bar_list(const std::vector<std::string>& names);
+// The choices' names as errors and --help say them: the command line's own way (cli/command_line.hpp).
+using cli::bar_list;
+using cli::spoken_list;
 
 template <typename Enum>
 ValueKind enum_choice(Enum ManagerConfig::*field, std::vector<std::pair<std::string, Enum>> names) {

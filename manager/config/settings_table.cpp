@@ -364,11 +364,21 @@ std::string flag_of(const std::string& key) {
   return flag;
 }
 
-std::string file_name_of(const std::string& key) {
+std::string section_of(const std::string& key) {
   for (const std::string& section : kSections) {
-    if (key.rfind(section + "_", 0) == 0) return section + "." + key.substr(section.size() + 1);
+    if (key.rfind(section + "_", 0) == 0) return section;
   }
-  return key;
+  return {};
+}
+
+std::string file_name_of(const std::string& key) {
+  const std::string section = section_of(key);
+  return section.empty() ? key : section + "." + key.substr(section.size() + 1);
+}
+
+std::string plain_text(std::string markdown) {
+  markdown.erase(std::remove(markdown.begin(), markdown.end(), '`'), markdown.end());
+  return markdown;
 }
 
 std::vector<std::string> split_commas(const std::string& text) {

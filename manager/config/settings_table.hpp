@@ -56,8 +56,14 @@ const Setting* find_setting(const std::string& key);
 /// "--max-sessions" for "max_sessions".
 std::string flag_of(const std::string& key);
 
+/// The file's section a key belongs to ("ros" for ros_connect), or "" for a top-level key.
+std::string section_of(const std::string& key);
+
 /// How the file and the docs name a key: "max_sessions", or "ros.connect" for a section's.
 std::string file_name_of(const std::string& key);
+
+/// A help or note's Markdown as a terminal or a YAML comment shows it: without the backticks of `code`.
+std::string plain_text(std::string markdown);
 
 /// `text` as a whole integer within [low, high] into `out`; false (and `out` untouched) otherwise.
 template <typename T>

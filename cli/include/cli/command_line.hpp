@@ -124,18 +124,28 @@ inline CLI::Validator non_empty() {
   return satisfies([](const std::string& text) { return !text.empty(); });
 }
 
+/// "a, b or c" for names {a, b, c}: how an error names the choices.
+inline std::string spoken_list(const std::vector<std::string>& names) {
+  std::string spoken;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    spoken += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  }
+  return spoken;
+}
+
+/// "a|b|c" for names {a, b, c}: how the help names the choices.
+inline std::string bar_list(const std::vector<std::string>& names) {
+  std::string joined;
+  for (std::size_t i = 0; i < names.size(); ++i) joined += (i == 0 ? "" : "|") + names[i];
+  return joined;
+}
+
 /// Makes `option` accept one of `names` only: the help shows "a|b|c", an error says "(expected a, b or c)".
 inline CLI::Option* one_of(CLI::Option* option, const std::vector<std::string>& names) {
-  std::string shown;
-  std::string expected;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    shown += (i == 0 ? "" : "|") + names[i];
-    expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
-  }
-  option->type_name(shown);
+  option->type_name(bar_list(names));
   return option->check(
       satisfies([names](const std::string& text) { return std::find(names.begin(), names.end(), text) != names.end(); },
-                expected));
+                spoken_list(names)));
 }
 
 namespace detail {
