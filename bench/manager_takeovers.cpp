@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 #include "manager_takeovers.hpp"
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -16,6 +14,7 @@
 
 #include "bench_util.hpp"
 #include "manager_probe.hpp"
+#include "source_address.hpp"
 
 namespace rfbsim::bench {
 
@@ -23,31 +22,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A blocking TCP connection from `source` to 127.0.0.1:`port`; -1 on failure.
-int connect_from(const std::string& source, int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) return -1;
-  sockaddr_in local{};
-  local.sin_family = AF_INET;
-  ::inet_pton(AF_INET, source.c_str(), &local.sin_addr);
-  sockaddr_in remote{};
-  remote.sin_family = AF_INET;
-  remote.sin_port = htons(static_cast<std::uint16_t>(port));
-  remote.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&local), sizeof local) != 0 ||
-      ::connect(fd, reinterpret_cast<sockaddr*>(&remote), sizeof remote) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
-}
-
 // Sends a WebSocket upgrade for `target` and reads the answer's status line; the status, or -1.
 int upgrade(int fd, const std::string& target, int port, const std::string& origin) {
-  const std::string request = "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
-                              "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\n"
-                              "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nOrigin: " +
-                              origin + "\r\n\r\n";
+  const std::string request = test::upgrade_request(target, port, origin);
   if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(request.size())) return -1;
   std::string head;
   const auto deadline = Clock::now() + std::chrono::seconds(5);
@@ -104,7 +81,7 @@ TakeoverStormResult run_takeover_storm(const ManagerRun& run, const std::string&
   for (int i = 0; i < options.upgrades; ++i) {
     std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(spacing * i));
     const std::string source = "127.0.1." + std::to_string(10 + i % options.addresses);
-    const int fd = connect_from(source, manager.port());
+    const int fd = test::connect_from(source, manager.port());
     const int status = fd < 0 ? -1 : upgrade(fd, target, manager.port(), manager.origin());
     if (status == 101) {
       ++result.switched;

@@ -93,27 +93,6 @@ std::vector<std::string> stat_fields(pid_t pid) {
 
 }  // namespace
 
-int connect_from(const std::string& source, int port, int receive_buffer) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) return -1;
-  if (receive_buffer > 0) ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof receive_buffer);
-  sockaddr_in local{};
-  local.sin_family = AF_INET;
-  sockaddr_in remote{};
-  remote.sin_family = AF_INET;
-  remote.sin_port = htons(static_cast<std::uint16_t>(port));
-  if (::inet_pton(AF_INET, source.c_str(), &local.sin_addr) != 1 ||
-      ::inet_pton(AF_INET, "127.0.0.1", &remote.sin_addr) != 1 ||
-      ::bind(fd, reinterpret_cast<sockaddr*>(&local), sizeof local) != 0 ||
-      ::connect(fd, reinterpret_cast<sockaddr*>(&remote), sizeof remote) != 0) {
-    const int saved = errno;
-    ::close(fd);
-    errno = saved;
-    return -1;
-  }
-  return fd;
-}
-
 net::HttpResponse request_from(const std::string& source, int port, const std::string& raw_request,
                                std::chrono::milliseconds timeout) {
   const int fd = connect_from(source, port);
@@ -138,13 +117,6 @@ std::string raw_request(const std::string& method, const std::string& target, in
   std::string request = method + " " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\n";
   for (const auto& [name, value] : headers) request += name + ": " + value + "\r\n";
   return request + "Connection: close\r\n\r\n";
-}
-
-std::string upgrade_request(const std::string& target, int port, const std::string& origin) {
-  return "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
-         "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\n"
-         "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n" +
-         (origin.empty() ? "" : "Origin: " + origin + "\r\n") + "\r\n";
 }
 
 bool peer_closed(int fd) {

@@ -19,12 +19,13 @@
 
 #include "http_client.hpp"
 #include "scoped_env.hpp"
+#include "source_address.hpp"
 
 namespace rfbsim::test::abuse {
 
-/// A TCP socket bound to `source` (a numeric IPv4 address) and connected to 127.0.0.1:`port` (blocking).
-/// `receive_buffer` > 0 sets SO_RCVBUF first, bytes. Returns the descriptor, or -1 with errno set.
-int connect_from(const std::string& source, int port, int receive_buffer = 0);
+// A socket from a chosen loopback address, and a WebSocket handshake (tests/support/source_address.hpp).
+using rfbsim::test::connect_from;
+using rfbsim::test::upgrade_request;
 
 /// Sends `raw_request` from `source` and reads until the server closes or `timeout` passes; parsed as
 /// net::http_request does (status -1 when nothing parseable came back).
@@ -34,9 +35,6 @@ net::HttpResponse request_from(const std::string& source, int port, const std::s
 /// A `method target HTTP/1.1` request for 127.0.0.1:`port` with `headers` and Connection: close.
 std::string raw_request(const std::string& method, const std::string& target, int port,
                         const std::vector<std::pair<std::string, std::string>>& headers = {});
-
-/// A WebSocket opening handshake for `target` (version 13, a fixed key) with `origin` ("" sends none).
-std::string upgrade_request(const std::string& target, int port, const std::string& origin);
 
 /// Whether the server has closed this socket (FIN or RST seen); never blocks. Reads away (and drops) whatever
 /// the server sent before, which would otherwise hide its FIN.
