@@ -22,6 +22,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "file_text.hpp"
 #include "manager_process.hpp"
 
 namespace rfbsim::test {
@@ -29,13 +30,6 @@ namespace rfbsim::test {
 namespace {
 
 using namespace std::chrono_literals;
-
-std::string read_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 // Waits up to `timeout` for child `pid`; true when it was reaped.
 bool reap_within(pid_t pid, std::chrono::milliseconds timeout) {
@@ -189,7 +183,7 @@ void ClusterUnderTest::launch(const ClusterOptions& options) {
       haproxy_pid_ = static_cast<pid_t>(std::stol(match[1]));
     }
   }
-  admin_token_ = read_file(run_dir_ / "admin-token");
+  admin_token_ = rfbsim::test::file_text(run_dir_ / "admin-token");
   if (static_cast<int>(hosts_.size()) != options.hosts || haproxy_pid_ <= 0 || admin_token_.empty()) {
     stop();
     throw std::runtime_error("run-cluster-demo.sh printed unexpected lines:\n" + output);
@@ -328,7 +322,7 @@ void ClusterUnderTest::signal_host(const std::string& id, int signal) {
 
 void ClusterUnderTest::restart_host(const std::string& id) {
   // The script's own argv for this host, NUL-separated.
-  const std::string saved = read_file(run_dir_ / (id + ".argv"));
+  const std::string saved = rfbsim::test::file_text(run_dir_ / (id + ".argv"));
   std::vector<std::string> args;
   for (std::size_t start = 0; start < saved.size();) {
     const std::size_t end = saved.find('\0', start);
@@ -346,7 +340,7 @@ void ClusterUnderTest::restart_host(const std::string& id) {
   const char* study_key = std::getenv("RFBSIM_ADDRESS_KEY");
   const std::string key_variable =
       "RFBSIM_ADDRESS_KEY=" + (study_key != nullptr && *study_key != '\0' ? std::string(study_key)
-                                                                          : read_file(run_dir_ / "address-key"));
+                                                                          : rfbsim::test::file_text(run_dir_ / "address-key"));
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
@@ -367,7 +361,7 @@ void ClusterUnderTest::restart_host(const std::string& id) {
   std::ofstream(run_dir_ / (id + ".pid")) << pid << "\n";
   const int port = host(id).port;
   if (!eventually([&] { return net::http_get(port, "/healthz", {}, false, 1s).status > 0; }, 30s, 100ms)) {
-    throw std::runtime_error(id + " did not come back; its log:\n" + read_file(log));
+    throw std::runtime_error(id + " did not come back; its log:\n" + rfbsim::test::file_text(log));
   }
 }
 
@@ -375,7 +369,7 @@ void ClusterUnderTest::reload_haproxy() {
   // The master logs "Loading success." once per worker it forked; a new one proves the reload happened (a
   // failed reload leaves the old worker running, which would pass every later check just the same).
   const auto loads = [&] {
-    const std::string log = read_file(run_dir_ / "haproxy.log");
+    const std::string log = rfbsim::test::file_text(run_dir_ / "haproxy.log");
     std::size_t count = 0;
     for (auto at = log.find("Loading success."); at != std::string::npos; at = log.find("Loading success.", at + 1)) {
       ++count;
@@ -385,7 +379,7 @@ void ClusterUnderTest::reload_haproxy() {
   const std::size_t before = loads();
   ::kill(haproxy_pid_, SIGUSR2);
   if (!eventually([&] { return loads() > before; }, 10s, 100ms)) {
-    throw std::runtime_error("HAProxy did not reload; its log:\n" + read_file(run_dir_ / "haproxy.log"));
+    throw std::runtime_error("HAProxy did not reload; its log:\n" + rfbsim::test::file_text(run_dir_ / "haproxy.log"));
   }
 }
 

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "file_text.hpp"
 #include "manager_process.hpp"
 
 using namespace std::chrono_literals;
@@ -94,13 +95,6 @@ std::string write_script(const fs::path& path, const std::string& body) {
   std::ofstream(path) << "#!/bin/sh\n" << body;
   fs::permissions(path, fs::perms::owner_all);
   return path.string();
-}
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 // The flags of a manager whose sessions are copied with `command`.
@@ -190,7 +184,7 @@ TEST_CASE("a copy that fails twice is tried again after its backoff and ends don
   REQUIRE(row);
   const fs::path folder = row->data_path;
   CHECK(tree(store.path() / folder.filename()) == tree(folder));
-  const std::string log = read_file(data.path() / "copy-logs" / (folder.filename().string() + ".log"));
+  const std::string log = rfbsim::test::file_text(data.path() / "copy-logs" / (folder.filename().string() + ".log"));
   CHECK(log.find("--- try 1 at ") != std::string::npos);
   CHECK(log.find("store unreachable (run 1)") != std::string::npos);
   CHECK(log.find("store unreachable (run 2)") != std::string::npos);
@@ -238,13 +232,13 @@ TEST_CASE("a copy cut short by a killed manager is done by the next one", "[mana
     ManagerUnderTest manager(data.path(), copy_flags({hanging, "{folder}"}));
     token = start_failing_session(manager, "restart-1");
     folder = manager.row_for_token(token)->data_path;
-    REQUIRE(rfbsim::test::eventually([&] { return !read_file(started).empty(); }, 20s));
+    REQUIRE(rfbsim::test::eventually([&] { return !rfbsim::test::file_text(started).empty(); }, 20s));
     const CopyColumns running = copy_columns(data.path(), token);
     CHECK(running.state == "pending");
     CHECK(running.attempts == 0);
     manager.process().stop(SIGKILL, 10s);
     // The command died with the manager (PR_SET_PDEATHSIG), and its try was never recorded.
-    const pid_t command = static_cast<pid_t>(std::stol(read_file(started)));
+    const pid_t command = static_cast<pid_t>(std::stol(rfbsim::test::file_text(started)));
     CHECK(rfbsim::test::eventually([&] { return !rfbsim::test::process_exists(command); }, 10s));
   }
   CHECK(copy_columns(data.path(), token).state == "pending");

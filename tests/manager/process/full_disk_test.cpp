@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 
+#include "file_text.hpp"
 #include "manager_process.hpp"
 #include "skip.hpp"
 
@@ -31,7 +32,7 @@ using rfbsim::test::with_small_sessions;
 
 namespace {
 
-bool write_text(const std::string& path, const std::string& text) {
+bool write_proc_file(const std::string& path, const std::string& text) {
   std::ofstream out(path);
   out << text;
   return static_cast<bool>(out.flush());
@@ -44,9 +45,9 @@ bool enter_private_mounts() {
   const gid_t gid = ::getegid();
   if (::unshare(CLONE_NEWNS) != 0) {
     if (::unshare(CLONE_NEWUSER | CLONE_NEWNS) != 0) return false;
-    if (!write_text("/proc/self/setgroups", "deny") ||
-        !write_text("/proc/self/uid_map", "0 " + std::to_string(uid) + " 1\n") ||
-        !write_text("/proc/self/gid_map", "0 " + std::to_string(gid) + " 1\n")) {
+    if (!write_proc_file("/proc/self/setgroups", "deny") ||
+        !write_proc_file("/proc/self/uid_map", "0 " + std::to_string(uid) + " 1\n") ||
+        !write_proc_file("/proc/self/gid_map", "0 " + std::to_string(gid) + " 1\n")) {
       return false;
     }
   }
@@ -72,16 +73,9 @@ std::uintmax_t fill_until_full(const std::string& path) {
   return written;
 }
 
-std::string read_file(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // Lines of the manager's log that say a session of `uid` started its program.
 bool started_program_for(const std::filesystem::path& log, const std::string& uid) {
-  std::istringstream lines(read_file(log));
+  std::istringstream lines(rfbsim::test::file_text(log));
   for (std::string line; std::getline(lines, line);) {
     if (line.find("(uid " + uid + "): started") != std::string::npos) return true;
   }
@@ -174,7 +168,7 @@ TEST_CASE("a data directory on a full 2 MiB tmpfs: nothing starts unrecorded, th
   {
     // A successor on the still-full disk says that it could not mark the session interrupted.
     ManagerUnderTest successor(data, flags, options);
-    CHECK(read_file(log).find("but the index took only 0 of them") != std::string::npos);
+    CHECK(rfbsim::test::file_text(log).find("but the index took only 0 of them") != std::string::npos);
     // Space returns: the refused writes catch up without a restart.
     for (int i = 1; i <= fillers; ++i) std::filesystem::remove(data / ("filler-" + std::to_string(i)));
     CHECK(successor.wait_for_row(live_token, [](const auto& row) { return row.state == "interrupted"; }, 40s));

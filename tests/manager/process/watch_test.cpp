@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "file_text.hpp"
 #include "manager_process.hpp"
 #include "rfb_test_client.hpp"
 #include "skip.hpp"
@@ -46,17 +47,10 @@ std::vector<std::string> minimal_session_flags(std::vector<std::string> more = {
   return flags;
 }
 
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // The lines of a session's events.jsonl written so far (a line still being written is left out).
 std::vector<nlohmann::json> read_events(const std::filesystem::path& file) {
   std::vector<nlohmann::json> events;
-  std::istringstream lines(read_text(file));
+  std::istringstream lines(rfbsim::test::file_text(file));
   std::string line;
   while (std::getline(lines, line)) {
     nlohmann::json event = nlohmann::json::parse(line, nullptr, false);
@@ -147,8 +141,8 @@ TEST_CASE("a watcher sees the session, but its keys and clicks never reach it", 
   participant.send_pointer(40, 50, 0);
   participant.send_key('p', true);
   participant.send_key('p', false);
-  REQUIRE(eventually([&] { return read_text(log).find("key 0x70 up") != std::string::npos; }, 10s));
-  const std::string text = read_text(log);
+  REQUIRE(eventually([&] { return rfbsim::test::file_text(log).find("key 0x70 up") != std::string::npos; }, 10s));
+  const std::string text = rfbsim::test::file_text(log);
   INFO("session log:\n" << text);
   CHECK(text.find("key 0x70 down") != std::string::npos);
   CHECK(text.find("pointer 40,50 buttons 1") != std::string::npos);
@@ -326,7 +320,7 @@ TEST_CASE("a researcher watching first does not start the participant's task clo
       20s));
   watcher.pump_until([] { return false; }, 1s);  // a few more ticks, in which a started clock would show
   const auto watched = read_events(events_file);
-  INFO("events.jsonl while only the watcher is there:\n" << read_text(events_file));
+  INFO("events.jsonl while only the watcher is there:\n" << rfbsim::test::file_text(events_file));
   const int watcher_connect = index_of(watched, "client", "connect");
   REQUIRE(watcher_connect >= 0);
   CHECK(watched[static_cast<std::size_t>(watcher_connect)].value("role", "") == "watcher");
@@ -345,7 +339,7 @@ TEST_CASE("a researcher watching first does not start the participant's task clo
       },
       20s));
   const auto events = read_events(events_file);
-  INFO("events.jsonl:\n" << read_text(events_file));
+  INFO("events.jsonl:\n" << rfbsim::test::file_text(events_file));
   REQUIRE(index_of(events, "client", "connect") == watcher_connect);
   const int participant_connect = index_of(events, "client", "connect", watcher_connect + 1);
   REQUIRE(participant_connect > watcher_connect);

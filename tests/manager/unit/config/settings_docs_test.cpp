@@ -7,6 +7,7 @@
 #include "config/config.hpp"
 #include "config/settings_docs.hpp"
 #include "config/settings_table.hpp"
+#include "file_text.hpp"
 
 using Catch::Contains;
 using rfbsim::manager::kSettingsDocsBegin;
@@ -17,19 +18,12 @@ namespace {
 
 const std::string kDeploymentDoc = std::string(RFBSIM_SOURCE_DIR) + "/docs/deployment.md";
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 }  // namespace
 
 // The docs' table is the generated one, character for character. After a change to the table, set
 // RFBSIM_WRITE_SETTINGS_DOCS=1 and run this test once to write it into docs/deployment.md.
 TEST_CASE("the docs' settings table is the declared one") {
-  std::string doc = read_file(kDeploymentDoc);
+  std::string doc = rfbsim::test::file_text(kDeploymentDoc);
   const std::size_t begin = doc.find(kSettingsDocsBegin);
   const std::size_t end = doc.find(kSettingsDocsEnd);
   REQUIRE(begin != std::string::npos);
