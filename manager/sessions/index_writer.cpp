@@ -48,18 +48,7 @@ void IndexWriter::run() {
       jobs_.pop_front();
       busy_ = true;
     }
-    std::string error;
-    try {
-      if (job.insert) {
-        index_.insert(job.session);
-      } else {
-        index_.write(job.session);  // the row too, where its insert had failed
-      }
-    } catch (const std::exception& failure) {
-      error = std::string("cannot write the index: ") + failure.what();
-    }
-    const std::string record_error = write_session_record(job.session);
-    if (error.empty()) error = record_error;
+    const std::string error = record_session(index_, job.session, job.insert);
     if (job.done) job.done(error);
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -67,6 +56,21 @@ void IndexWriter::run() {
     }
     idle_.notify_all();
   }
+}
+
+std::string record_session(SessionIndex& index, const Session& session, bool insert) {
+  std::string error;
+  try {
+    if (insert) {
+      index.insert(session);
+    } else {
+      index.write(session);  // the row too, where its insert had failed
+    }
+  } catch (const std::exception& failure) {
+    error = std::string("cannot write the index: ") + failure.what();
+  }
+  const std::string record_error = write_session_record(session);
+  return error.empty() ? record_error : error;
 }
 
 std::string write_session_record(const Session& session) {

@@ -59,6 +59,10 @@ class IndexWriter {
   std::thread thread_;  // last: starts once everything above exists
 };
 
+/// Writes `session` to `index` (a new row with `insert`, else SessionIndex::write) and then its manager.json, on
+/// the caller's thread; "" or what went wrong (the index's failure first).
+std::string record_session(SessionIndex& index, const Session& session, bool insert);
+
 /// Writes `session_record_json(session)` to `<data_path>/manager.json` through a temporary file renamed over
 /// it, so that a reader never sees half of one. "" or what went wrong. Not synced: the index is the durable
 /// record, this a copy for the study's tools.

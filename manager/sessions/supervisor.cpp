@@ -252,13 +252,7 @@ Supervisor::Recovery Supervisor::recover_interrupted() {
     ++ended_counts_[SessionState::kInterrupted];
     // Written here and now, through the I/O thread's own connection (nothing else runs yet), so that what the
     // start-up says it marked is what the index holds. A refusal joins the other writes to try again.
-    std::string error;
-    try {
-      index_.update(session);
-      error = write_session_record(session);
-    } catch (const std::exception& failure) {
-      error = std::string("cannot write the index: ") + failure.what();
-    }
+    const std::string error = record_session(index_, session, false);
     if (error.empty()) {
       ++recovery.recorded;
       if (copy) copy("");
