@@ -34,8 +34,11 @@ command -v npm >/dev/null 2>&1 || packages+=(npm)
 # HAProxy for the cluster tests (scripts/run-cluster-demo.sh; a study installs it on its balancer host),
 # MuJoCo for examples/mujoco_rfb, and TigerVNC's Xvnc with a few X11 programs (glxgears, xeyes, Xlib for our
 # key-echo program) for session_kind x11 (docs/other-simulators.md; a study installs what its own kind needs).
+# Clients we did not write: Firefox ESR (driven over WebDriver BiDi), TigerVNC's viewer under Xvfb with xdotool
+# for keys, and Debian's stock noVNC 1.3 page (bench_network's JPEG-only browser row).
 [ "$with_browser" = 1 ] && packages+=(chromium clang libclang-rt-14-dev haproxy
-  libmujoco-dev tigervnc-standalone-server mesa-utils x11-apps x11-utils libx11-dev)
+  libmujoco-dev tigervnc-standalone-server mesa-utils x11-apps x11-utils libx11-dev
+  firefox-esr tigervnc-viewer xvfb xdotool novnc)
 
 missing=()
 for p in "${packages[@]}"; do
