@@ -8,8 +8,9 @@
 //      seed) with one client; the participant walks and turns (network_cells.hpp). One table per path, then
 //      fps ratios against RTT 0, key-to-picture against RTT, and H.264's bytes against Tight JPEG's.
 //   2. The long run: 60 s at 50 ms RTT and 5 Mbit/s (cu and h264): latency in the first and the last 20 s.
-//   3. noVNC in Chromium (bench_network_browser.mjs) through the emulator at each RTT, no cap: pictures per
-//      second in the page and the encoding the server chose (network_browser.hpp).
+//   3. Browsers (bench_network_browser.mjs) through the emulator at each RTT, no cap: our page in Chromium (the
+//      default codec, jpeg, h264) and Firefox, and stock noVNC 1.3: pictures per second in the page, key to
+//      picture, and the encoding and quality the server chose (network_browser.hpp).
 //   4. H.264 against Tight JPEG q80 on the same rendered frames, in process: SSIM against the frame, bytes and
 //      encode time per 720p frame, one frame at a time (network_codec.hpp), and as live streams paced by the
 //      congestion control through the emulator, no cap and 50 ms + 5 Mbit/s (network_tagged.hpp).
@@ -60,6 +61,9 @@ struct Options {
   double threshold = 12.0;
   int long_seconds = 60;  // 0 = no long run
   std::vector<int> browser_rtts{0, 50, 100, 200};  // empty = no browser rows
+  std::vector<bench::BrowserClient> browser_clients = bench::browser_clients();
+  bool browser_trace = false;
+  int browser_cap = 0;  // Mbit/s, 0 = none
   int codec_frames = 150;                          // 0 = no codec tables (lockstep and live)
   bool mad_trace = false;
   std::uint32_t turn_key = 'd';
@@ -108,6 +112,12 @@ Options parse_options(int argc, char** argv) {
   cli.number("--long-seconds", o.long_seconds, 0, 3600, "seconds of the lag check (0: none)");
   cli.value("--browser-rtts", o.browser_rtts, parse_rtts, "noVNC's round-trip times in ms (MS,... or none)")
       ->type_name("MS,...")->default_str(bench::joined(o.browser_rtts, ms));
+  cli.list("--browser-clients", o.browser_clients, bench::parse_browser_client,
+           [](const bench::BrowserClient& client) { return client.name; },
+           "browser clients: auto (our page, Chromium, the default codec), jpeg, h264, firefox (our page, default "
+           "codec), firefox-h264, firefox-manager (a sim_manager session), novnc13 (Debian's stock noVNC 1.3 page, Chromium)");
+  cli.number("--browser-cap", o.browser_cap, 0, 10000, "the browser rows' link cap in Mbit/s (0: none)");
+  cli.flag("--browser-trace", o.browser_trace, "print sim_rfb's stream reports of each browser run");
   cli.number("--codec-frames", o.codec_frames, 0, 100000, "frames of the codec tables (0: none)");
   cli.flag("--mad-trace", o.mad_trace, "print each press's MAD series");
   cli.value("--key", o.turn_key, bench::parse_key, "the key pressed (one character)")
@@ -204,9 +214,16 @@ int run(const Options& options) {
   // 3. noVNC in Chromium.
   std::vector<bench::BrowserRow> browser_rows;
   if (!options.browser_rtts.empty()) {
-    browser_rows = bench::run_browser_rows(options.sim, options.source_dir, options.browser_rtts,
-                                           std::chrono::seconds(options.warm_up), std::chrono::seconds(options.seconds),
-                                           options.presses, options.threshold);
+    bench::BrowserPlan browser_plan;
+    browser_plan.clients = options.browser_clients;
+    browser_plan.rtts = options.browser_rtts;
+    browser_plan.cap_mbit = options.browser_cap;
+    browser_plan.warm_up = std::chrono::seconds(options.warm_up);
+    browser_plan.measure = std::chrono::seconds(options.seconds);
+    browser_plan.presses = options.presses;
+    browser_plan.threshold = options.threshold;
+    browser_plan.trace = options.browser_trace;
+    browser_rows = bench::run_browser_rows(options.sim, options.source_dir, browser_plan);
   }
 
   // 4. H.264 against JPEG on the same frames.

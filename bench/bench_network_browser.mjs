@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// bench_network's browser row: the participant page (noVNC) in headless Chromium, walking and turning, counting
-// the pictures it shows. bench_network starts sim_rfb and a LinkEmulator in front of it and runs this script
-// with the emulator's URL; the script prints one line `BENCH_RESULT {json}` and exits 0, or prints
-// `BENCH_ERROR message` and exits 1.
+// bench_network's browser row: a noVNC page in a headless browser, walking and turning, counting the pictures it
+// shows. bench_network starts sim_rfb and a LinkEmulator in front of it and runs this script with the emulator's
+// URL; the script prints one line `BENCH_RESULT {json}` and exits 0, or prints `BENCH_ERROR message` and exits 1.
 //
-// Usage: node bench_network_browser.mjs --url URL --web-dir DIR [--warm-up-ms N] [--measure-ms N] [--presses N]
-//                                       [--threshold MAD] [--chromium PATH]
+// Usage: node bench_network_browser.mjs --url URL --web-dir DIR [--browser chromium|firefox]
+//            [--page bundled|novnc13] [--warm-up-ms N] [--measure-ms N] [--presses N] [--threshold MAD]
+//            [--chromium PATH] [--firefox PATH]
 //   --url         the page, e.g. http://127.0.0.1:PORT/ (a secure context: noVNC 1.7 offers H.264 there)
-//   --web-dir     the source web/ folder whose node_modules holds playwright-core
+//   --web-dir     the source web/ folder whose node_modules holds playwright-core and puppeteer-core
+//   --browser     chromium (playwright-core) or firefox (Debian's firefox-esr through puppeteer-core, WebDriver BiDi)
+//   --page        bundled: our participant page; novnc13: Debian's stock noVNC 1.3 vnc.html (its own canvas, no
+//                 rfbsimState: the first picture is its canvas sized and connected)
 //   --rtt-ms      the link's round trip: pictures sooner after a press cannot show it (they become its reference)
 //   --trace 1     also print `BENCH_TRACE [[ms, MAD], ...] per press` (to check the threshold)
 //
@@ -37,7 +40,12 @@ const MEASURE_MS = Number(args['measure-ms'] || 10000);
 const PRESSES = Number(args.presses || 10);
 const THRESHOLD = Number(args.threshold || 12);
 const RTT_MS = Number(args['rtt-ms'] || 0);
+const BROWSER = args.browser || 'chromium';
+const PAGE = args.page || 'bundled';
 const CHROMIUM = args.chromium || process.env.RFBSIM_CHROMIUM || '/usr/bin/chromium';
+const FIREFOX = args.firefox || process.env.RFBSIM_FIREFOX || '/usr/bin/firefox-esr';
+// The view: our page's canvas, or noVNC 1.3's.
+const VIEW = PAGE === 'novnc13' ? '#noVNC_container canvas' : '#screen canvas';
 const TURN_HOLD_MS = 300;
 const AFTER_TURN_MS = 200;     // a turn's last pictures are in this long after its hold, from its first one
 const PRESS_TIMEOUT_MS = 3000;
@@ -69,7 +77,7 @@ function countWebSocketBytes() {
 }
 
 // Runs in the page once a picture shows: the probe loop and the press bookkeeping (window.__bench).
-function installProbe({ threshold, rttMs }) {
+function installProbe({ threshold, rttMs, viewSelector }) {
   const W = 320;
   const H = 180;
   const probe = document.createElement('canvas');
@@ -96,7 +104,7 @@ function installProbe({ threshold, rttMs }) {
   }, true);
   const look = () => {
     const now = performance.now();
-    const view = document.querySelector('#screen canvas');
+    const view = document.querySelector(viewSelector);
     if (view && view.width > 0) {
       context.drawImage(view, 0, 0, W, H);
       const pixels = context.getImageData(0, 0, W, H).data;
@@ -124,10 +132,34 @@ function installProbe({ threshold, rttMs }) {
   requestAnimationFrame(look);
 }
 
-async function main() {
+// The page in the chosen browser, behind the few calls this script makes (the two drivers name them differently).
+async function openPage() {
+  const require = createRequire(path.join(WEB_DIR, 'package.json'));
+  const viewport = { width: 1280, height: 760 };
+  if (BROWSER === 'firefox') {
+    let puppeteer;
+    try {
+      puppeteer = require('puppeteer-core');
+    } catch (err) {
+      fail(`cannot load puppeteer-core from ${WEB_DIR}/node_modules: ${err.message}`);
+    }
+    const browser = await puppeteer.launch({ browser: 'firefox', executablePath: FIREFOX, headless: true,
+                                             timeout: 30_000 });
+    const page = await browser.newPage();
+    await page.setViewport(viewport);
+    return {
+      close: () => browser.close(),
+      beforeScripts: (fn) => page.evaluateOnNewDocument(fn),
+      goto: (url) => page.goto(url, { waitUntil: 'load', timeout: 30_000 }),
+      waitFor: (fn) => page.waitForFunction(fn, { timeout: 30_000, polling: 100 }),
+      click: (selector) => page.click(selector),
+      evaluate: (fn, arg) => page.evaluate(fn, arg),
+      keyboard: page.keyboard,
+    };
+  }
   let chromium;
   try {
-    chromium = createRequire(path.join(WEB_DIR, 'package.json'))('playwright-core').chromium;
+    chromium = require('playwright-core').chromium;
   } catch (err) {
     fail(`cannot load playwright-core from ${WEB_DIR}/node_modules: ${err.message}`);
   }
@@ -138,15 +170,33 @@ async function main() {
            '--disable-component-update', '--disable-sync'],
     timeout: 30_000,
   });
+  const page = await browser.newPage({ viewport });
+  return {
+    close: () => browser.close(),
+    beforeScripts: (fn) => page.addInitScript(fn),
+    goto: (url) => page.goto(url, { waitUntil: 'load', timeout: 30_000 }),
+    waitFor: (fn) => page.waitForFunction(fn, null, { timeout: 30_000, polling: 100 }),
+    click: (selector) => page.locator(selector).click(),
+    evaluate: (fn, arg) => page.evaluate(fn, arg),
+    keyboard: page.keyboard,
+  };
+}
+
+async function main() {
+  const page = await openPage();
   try {
-    const page = await browser.newPage({ viewport: { width: 1280, height: 760 } });
-    await page.addInitScript(countWebSocketBytes);
-    await page.goto(URL_, { waitUntil: 'load', timeout: 30_000 });
-    // The first picture: app.js records it in rfbsimState.firstFrameAt.
-    await page.waitForFunction(() => window.rfbsimState && window.rfbsimState.firstFrameAt !== null,
-                               null, { timeout: 30_000, polling: 100 });
-    await page.locator('#screen canvas').click();
-    await page.evaluate(installProbe, { threshold: THRESHOLD, rttMs: RTT_MS });
+    await page.beforeScripts(countWebSocketBytes);
+    await page.goto(URL_);
+    // The first picture: our page records it in rfbsimState.firstFrameAt; noVNC 1.3 marks the document
+    // connected and sizes its canvas to the session.
+    if (PAGE === 'novnc13') {
+      await page.waitFor(() => document.documentElement.classList.contains('noVNC_connected') &&
+                               (document.querySelector('#noVNC_container canvas')?.width ?? 0) > 100);
+    } else {
+      await page.waitFor(() => window.rfbsimState && window.rfbsimState.firstFrameAt !== null);
+    }
+    await page.click(VIEW);
+    await page.evaluate(installProbe, { threshold: THRESHOLD, rttMs: RTT_MS, viewSelector: VIEW });
     await page.keyboard.down('w');
 
     // The press schedule runs through the warm-up too; only the window's presses count.
@@ -200,14 +250,14 @@ async function main() {
                                              at: performance.now() }));
     await page.keyboard.up('w');
     const seconds = (end.at - base.at) / 1000;
-    const state = await page.evaluate(() => JSON.parse(JSON.stringify(window.rfbsimState)));
+    const state = await page.evaluate(() => JSON.parse(JSON.stringify(window.rfbsimState ?? { connected: null })));
     if (args.trace) console.log(`BENCH_TRACE ${JSON.stringify(await page.evaluate(() => window.__bench.traces))}`);
     console.log(`BENCH_RESULT ${JSON.stringify({
       seconds, fps: (end.pictures - base.pictures) / seconds, mbit: ((end.bytes - base.bytes) * 8) / seconds / 1e6,
       presses, timeouts, latencies, connected: state.connected,
     })}`);
   } finally {
-    await browser.close();
+    await page.close();
   }
 }
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "manager_process.hpp"
 #include "network_report.hpp"
 #include "sim_process.hpp"
 
@@ -53,22 +54,64 @@ std::string line_after(const std::string& output, const std::string& marker) {
   return output.substr(at + marker.size(), end == std::string::npos ? std::string::npos : end - at - marker.size());
 }
 
-BrowserRow run_browser(const SimSettings& settings, const std::string& source_dir, const std::string& codec, int rtt,
-                       std::chrono::seconds warm_up, std::chrono::seconds measure, int presses, double threshold) {
+// Debian's novnc package: noVNC 1.3's own page, served by sim_rfb in place of ours.
+constexpr const char* kStockNoVncRoot = "/usr/share/novnc";
+
+// A copy of the stock page that sim_rfb can serve: it wants an index.html (the package has vnc.html), and the
+// package's links are followed into plain files.
+void copy_stock_novnc(const std::filesystem::path& to) {
+  namespace fs = std::filesystem;
+  fs::copy(kStockNoVncRoot, to, fs::copy_options::recursive);
+  fs::copy_file(to / "vnc.html", to / "index.html", fs::copy_options::overwrite_existing);
+}
+
+// Where the script opens the client: our page, or noVNC 1.3's vnc.html beside it connecting to the same port
+// (sim_rfb upgrades any path), without its reconnect and at its default quality.
+std::string page_url(const BrowserClient& client, const CellPath& path) {
+  if (client.page == "novnc13") {
+    return path.page_url() + "vnc.html?autoconnect=true&reconnect=false&resize=scale&path=websockify";
+  }
+  return path.page_url();
+}
+
+void print_trace(const BrowserRow& row, Clock::time_point started) {
+  for (const StreamSample& s : row.samples) {
+    std::printf("trace %s RTT %d t=%.1f %s q%.0f level %.0f fps %.1f rtt %.0f/%.0f window %.0f held %.0f\n",
+                row.client.name.c_str(), row.rtt_ms, std::chrono::duration<double>(s.at - started).count(),
+                s.encoding.c_str(), s.quality, s.quality_level, s.fps, s.last_rtt_ms, s.base_rtt_ms, s.window_bytes,
+                s.updates_held);
+  }
+}
+
+BrowserRow run_browser(SimSettings settings, const std::string& source_dir, const BrowserClient& client, int rtt,
+                       const BrowserPlan& plan) {
   BrowserRow row;
-  row.codec = codec;
+  row.client = client;
   row.rtt_ms = rtt;
-  const auto path = open_path(PathKind::kDirect, settings, codec, test::link_profile(std::chrono::milliseconds(rtt)));
+  test::TempDir web_root("rfbsim-bench-novnc13");
+  if (client.page == "novnc13") {
+    if (!std::filesystem::is_regular_file(std::string(kStockNoVncRoot) + "/vnc.html")) {
+      row.error = "no stock noVNC at /usr/share/novnc (apt-get install novnc)";
+      return row;
+    }
+    copy_stock_novnc(web_root.path() / "page");
+    settings.extra_args = {"--web-root", (web_root.path() / "page").string()};
+  }
+  const auto started = Clock::now();
+  const auto path =
+      open_path(client.path, settings, client.codec, test::link_profile(std::chrono::milliseconds(rtt), plan.cap_mbit));
   StreamSampler sampler(*path);
   const std::string script = (std::filesystem::path(source_dir) / "bench" / "bench_network_browser.mjs").string();
   const std::vector<std::string> args = {
-      script, "--url", "http://127.0.0.1:" + std::to_string(path->client_port()) + "/", "--web-dir",
-      (std::filesystem::path(source_dir) / "web").string(), "--warm-up-ms", std::to_string(warm_up.count() * 1000),
-      "--measure-ms", std::to_string(measure.count() * 1000), "--presses", std::to_string(presses), "--threshold",
-      fixed(threshold, 1), "--rtt-ms", std::to_string(rtt)};
-  const auto limit = warm_up + measure * 3 + std::chrono::seconds(90);
+      script, "--url", page_url(client, *path), "--web-dir",
+      (std::filesystem::path(source_dir) / "web").string(), "--browser", client.browser, "--page", client.page,
+      "--warm-up-ms", std::to_string(plan.warm_up.count() * 1000), "--measure-ms",
+      std::to_string(plan.measure.count() * 1000), "--presses", std::to_string(plan.presses), "--threshold",
+      fixed(plan.threshold, 1), "--rtt-ms", std::to_string(rtt)};
+  const auto limit = plan.warm_up + plan.measure * 3 + std::chrono::seconds(90);
   const test::ExitResult exit = test::run_to_exit(settings.node, args, limit);
   row.samples = sampler.finish();
+  if (plan.trace) print_trace(row, started);
   const std::string result = line_after(exit.output, kResultMarker);
   if (result.empty()) {
     const std::string error = line_after(exit.output, kErrorMarker);
@@ -88,18 +131,35 @@ BrowserRow run_browser(const SimSettings& settings, const std::string& source_di
 
 }  // namespace
 
+std::vector<BrowserClient> browser_clients() {
+  return {{"auto", "chromium", "bundled", "auto"},
+          {"jpeg", "chromium", "bundled", "jpeg"},
+          {"h264", "chromium", "bundled", "h264"},
+          {"firefox", "firefox", "bundled", "auto"},
+          {"firefox-h264", "firefox", "bundled", "h264"},
+          {"firefox-manager", "firefox", "bundled", "auto", PathKind::kManager},
+          {"novnc13", "chromium", "novnc13", "auto"}};
+}
+
+BrowserClient parse_browser_client(const std::string& name) {
+  for (const BrowserClient& client : browser_clients()) {
+    if (client.name == name) return client;
+  }
+  throw std::invalid_argument("unknown browser client '" + name + "' (auto, jpeg, h264, firefox, firefox-h264, firefox-manager or novnc13)");
+}
+
 std::vector<BrowserRow> run_browser_rows(const SimSettings& settings, const std::string& source_dir,
-                                         const std::vector<int>& rtts, std::chrono::seconds warm_up,
-                                         std::chrono::seconds measure, int presses, double threshold) {
+                                         const BrowserPlan& plan) {
   std::vector<BrowserRow> rows;
-  for (const std::string codec : {"jpeg", "h264"}) {
-    for (const int rtt : rtts) {
-      std::fprintf(stderr, "bench_network: browser, --codec %s, RTT %d ms ...\n", codec.c_str(), rtt);
+  for (const BrowserClient& client : plan.clients) {
+    for (const int rtt : plan.rtts) {
+      std::fprintf(stderr, "bench_network: browser %s (%s, %s page, --codec %s), RTT %d ms ...\n",
+                   client.name.c_str(), client.browser.c_str(), client.page.c_str(), client.codec.c_str(), rtt);
       try {
-        rows.push_back(run_browser(settings, source_dir, codec, rtt, warm_up, measure, presses, threshold));
+        rows.push_back(run_browser(settings, source_dir, client, rtt, plan));
       } catch (const std::exception& error) {
         BrowserRow failed;
-        failed.codec = codec;
+        failed.client = client;
         failed.rtt_ms = rtt;
         failed.error = error.what();
         rows.push_back(std::move(failed));
@@ -111,13 +171,13 @@ std::vector<BrowserRow> run_browser_rows(const SimSettings& settings, const std:
 }
 
 void print_browser_rows(const std::vector<BrowserRow>& rows) {
-  Table table({"--codec", "RTT ms", "page fps", "fps / fps at 0", "page Mbit/s", "key p50 ms", "key p95 ms",
-               "presses (timed out)", "server fps p50", "server RTT p50", "server chose"},
+  Table table({"client", "RTT ms", "page fps", "fps / fps at 0", "page Mbit/s", "key p50 ms", "key p90 ms",
+               "presses (timed out)", "server fps p50", "server RTT p50", "server chose (at the end)"},
               1);
   double base_fps = kNaN;
-  std::string base_codec;
+  std::string base_client;
   for (const BrowserRow& row : rows) {
-    std::vector<std::string> cells{row.codec, std::to_string(row.rtt_ms)};
+    std::vector<std::string> cells{row.client.name, std::to_string(row.rtt_ms)};
     if (!row.error.empty()) {
       cells.push_back("failed: " + row.error);
       table.add_row(std::move(cells));
@@ -125,9 +185,9 @@ void print_browser_rows(const std::vector<BrowserRow>& rows) {
     }
     if (row.rtt_ms == 0) {
       base_fps = row.page_fps;
-      base_codec = row.codec;
+      base_client = row.client.name;
     }
-    const double ratio = base_codec == row.codec ? row.page_fps / base_fps : kNaN;
+    const double ratio = base_client == row.client.name ? row.page_fps / base_fps : kNaN;
     std::vector<double> server_fps, server_rtt;
     std::string chose = "-";
     for (const StreamSample& s : row.samples) {
@@ -139,7 +199,7 @@ void print_browser_rows(const std::vector<BrowserRow>& rows) {
     }
     const auto text = [](double v, int d) { return std::isnan(v) ? std::string("-") : fixed(v, d); };
     cells.insert(cells.end(), {fixed(row.page_fps, 1), text(ratio, 2), fixed(row.page_mbit, 2),
-                               text(quantile(row.latencies_ms, 0.5), 0), text(quantile(row.latencies_ms, 0.95), 0),
+                               text(quantile(row.latencies_ms, 0.5), 0), text(quantile(row.latencies_ms, 0.9), 0),
                                std::to_string(row.presses) + " (" + std::to_string(row.timeouts) + ")",
                                text(quantile(server_fps, 0.5), 1), text(quantile(server_rtt, 0.5), 0), chose});
     table.add_row(std::move(cells));

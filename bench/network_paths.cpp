@@ -51,6 +51,7 @@ class DirectPath final : public CellPath {
       : sim_(start(settings, codec)), link_("127.0.0.1", sim_->port(), profile) {}
   [[nodiscard]] int client_port() const override { return link_.port(); }
   [[nodiscard]] test::LinkEmulator& link() override { return link_; }
+  [[nodiscard]] std::string page_url() const override { return "http://127.0.0.1:" + std::to_string(link_.port()) + "/"; }
   [[nodiscard]] std::optional<StreamSample> sample() const override {
     const std::string body = test::http_body(test::http_get(sim_->port(), "/status.json", milliseconds(2000)));
     return parse_status_stream(body);
@@ -61,6 +62,7 @@ class DirectPath final : public CellPath {
     std::vector<std::string> args = {"--port", "0"};
     const std::vector<std::string> more = sim_args(settings, codec);
     args.insert(args.end(), more.begin(), more.end());
+    args.insert(args.end(), settings.extra_args.begin(), settings.extra_args.end());
     const StderrToFile redirect(settings.log);
     return std::make_unique<test::SimProcess>(settings.sim, args);
   }
@@ -76,7 +78,9 @@ class ManagerPath final : public CellPath {
       : data_("rfbsim-bench-network"), manager_(start(settings, codec, data_.path())) {
     static std::atomic<int> counter{0};
     const std::string uid = "bench-network-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-    const test::net::HttpResponse response = manager_->start("uid=" + uid + "&scenario=" + settings.scenario);
+    // The seed goes in the link: the manager sets every session's --seed itself.
+    const test::net::HttpResponse response = manager_->start("uid=" + uid + "&scenario=" + settings.scenario +
+                                                             "&seed=" + std::to_string(settings.seed));
     token_ = test::token_from_redirect(response);
     if (token_.empty()) {
       throw std::runtime_error("/start answered " + std::to_string(response.status) + ": " +
@@ -100,6 +104,9 @@ class ManagerPath final : public CellPath {
 
   [[nodiscard]] int client_port() const override { return bridge_->port(); }
   [[nodiscard]] test::LinkEmulator& link() override { return *link_; }
+  [[nodiscard]] std::string page_url() const override {
+    return "http://127.0.0.1:" + std::to_string(link_->port()) + "/s/" + token_ + "/";
+  }
   [[nodiscard]] std::optional<StreamSample> sample() const override {
     const test::net::HttpResponse response = manager_->get("/metrics");
     if (response.status != 200) return std::nullopt;
@@ -117,6 +124,9 @@ class ManagerPath final : public CellPath {
       } else if (line.rfind("rfbsim_session_fps" + label + "}", 0) == 0) {
         s.fps = value();
         any = true;
+      } else if (line.rfind("rfbsim_session_quality" + label + "}", 0) == 0) {
+        s.quality = value();
+        any = true;
       } else if (line.rfind("rfbsim_session_codec_info" + label + ",codec=\"", 0) == 0) {
         const auto from = line.find("codec=\"") + 7;
         s.encoding = line.substr(from, line.find('"', from) - from);
@@ -132,11 +142,11 @@ class ManagerPath final : public CellPath {
                                                        const std::filesystem::path& data_dir) {
     std::vector<std::string> flags = {"--max-sessions", "1", "--admin-token", kAdminToken, "--scenarios",
                                       settings.scenario, "--max-duration-s", "3600", "--codec", codec};
-    // The manager names the scenario and a seed of its own; ours come after and win.
+    // The manager passes the scenario and the codec itself, and the seed from the link.
     std::vector<std::string> session = sim_args(settings, codec);
     for (std::size_t i = 0; i < session.size(); ++i) {
-      if (session[i] == "--scenario" || session[i] == "--codec") {
-        ++i;  // the manager passes these itself
+      if (session[i] == "--scenario" || session[i] == "--codec" || session[i] == "--seed") {
+        ++i;
         continue;
       }
       flags.insert(flags.end(), {"--session-arg", session[i]});
@@ -216,6 +226,7 @@ std::optional<StreamSample> parse_status_stream(const std::string& json) {
   s.window_bytes = json_field(entry, "window_bytes");
   s.updates_held = json_field(entry, "updates_held");
   s.quality = json_field(entry, "quality");
+  s.quality_level = json_field(entry, "quality_level");
   s.fps = json_field(entry, "fps");
   return s;
 }

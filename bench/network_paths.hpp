@@ -45,6 +45,7 @@ struct SimSettings {
   std::string avatar_start;              ///< sim_rfb --avatar-start ("" = the scenario's)
   std::string log;                       ///< children's stderr is appended here
   std::string node = "/usr/bin/node";    ///< node, for the browser rows
+  std::vector<std::string> extra_args;   ///< more sim_rfb flags (direct path), e.g. another --web-root
 };
 
 /// What the server reported about the (only) client's stream at one moment; NaN / "" for what it did not say.
@@ -55,7 +56,8 @@ struct StreamSample {
   double last_rtt_ms = kNaN;    ///< latest round trip
   double window_bytes = kNaN;   ///< congestion window (direct only)
   double updates_held = kNaN;   ///< frames held back because the link was full, so far (direct only)
-  double quality = kNaN;        ///< JPEG quality in use (Tight), or the configured one (direct only)
+  double quality = kNaN;        ///< JPEG quality in use (Tight), or the configured one (H.264)
+  double quality_level = kNaN;  ///< the adaptive ladder's level (0 = top) (direct only)
   double fps = kNaN;            ///< updates per second lately
 };
 
@@ -67,6 +69,9 @@ class CellPath {
   [[nodiscard]] virtual int client_port() const = 0;
   /// The emulated link (stats, peaks).
   [[nodiscard]] virtual test::LinkEmulator& link() = 0;
+  /// The participant page through the emulated link, for a browser: sim_rfb's own page (direct), or the
+  /// session's page under the manager.
+  [[nodiscard]] virtual std::string page_url() const = 0;
   /// One look at the server's report of its client's stream (sim_rfb's /status.json, or sim_manager's
   /// /metrics); nullopt when no stream is reported. Safe from any thread; a few ms.
   [[nodiscard]] virtual std::optional<StreamSample> sample() const = 0;

@@ -4,7 +4,10 @@
 // A frame held back by congestion control coalesces with the next one, so a link that cannot carry the
 // frame rate at this quality shows as a share of held frames. Then the quality steps down one level of a
 // ladder derived from the configured top quality, waits until the effect shows, and steps again if it
-// must. It steps back up once nothing has been held for a few seconds and the link's measured rate would
+// must. Frames are also held when the client, not the link, is slow (a page decoding slowly, a busy
+// laptop): its answers to our pings come late whatever the bytes. Smaller pictures do not help there, and
+// that is how it shows: a step down that leaves frames held without sending more of them a second is taken
+// back, and no step down is tried for a while. It steps back up once nothing has been held for a few seconds and the link's measured rate would
 // carry the next level up; a step up that fails at once makes the next try wait twice as long. When the
 // picture stops changing, a frame sent below the top level is refreshed once at the top level. Knows
 // nothing of sockets or encoders; time is passed in, so tests drive it with a fake clock.
@@ -39,6 +42,8 @@ struct AdaptiveQualityConfig {
   std::chrono::milliseconds probation{10000};    ///< a step down this soon after a step up: it failed
   int max_backoff = 8;  ///< failed step ups multiply `recovery` and `probe_after` by up to this
   std::chrono::milliseconds still_delay{500};  ///< a picture still this long is refreshed at the top level
+  double useful_gain = 1.15;  ///< a step down that still holds frames must raise the sent frame rate this much
+  std::chrono::milliseconds slow_client_wait{30000};  ///< no step down this long after one was taken back
 };
 
 /// The ladder for `top_quality`: about 1, 0.8, 0.6 and 0.45 of it, then `floor_quality`, all 4:2:0,
@@ -82,6 +87,11 @@ class AdaptiveQuality {
   [[nodiscard]] const std::vector<QualityLevel>& levels() const { return levels_; }
   /// Bytes per frame expected one level up (0 at the top or before three frames at this level).
   [[nodiscard]] double next_level_bytes() const;
+  /// True once the quality is below the top and the step there has shown that it helped (more frames sent a
+  /// second, or none held): the link, not the client, limits the stream.
+  [[nodiscard]] bool link_bound() const { return level_ > 0 && step_down_helped_; }
+  /// True while step downs wait because the last one did not help (the client, not the link, is slow).
+  [[nodiscard]] bool client_bound(TimePoint now) const { return no_step_down_until_ && now < *no_step_down_until_; }
 
  private:
   struct Offer {
@@ -89,8 +99,18 @@ class AdaptiveQuality {
     bool held;
   };
 
-  void forget_old_offers(TimePoint now);
+  struct StepDown {
+    TimePoint at;
+    std::size_t from;   // the level it left
+    double sent_fps;    // frames sent a second at that level, just before
+  };
+
+  void forget_old_frames(TimePoint now);
   void change_level(TimePoint now, std::size_t level);
+  [[nodiscard]] double sent_fps() const;
+  // After a step down's hold-off: keeps it when it helped, takes it back when frames are still held and it did
+  // not raise the sent frame rate. Returns true when it took it back.
+  bool judge_step_down(TimePoint now, bool too_many_held);
 
   AdaptiveQualityConfig config_;
   std::vector<QualityLevel> levels_;
@@ -103,6 +123,12 @@ class AdaptiveQuality {
   std::size_t sent_at_level_ = 0;
   std::optional<TimePoint> last_step_up_;  // still on probation
   int backoff_ = 1;                        // doubles per failed step up
+
+  std::deque<TimePoint> sent_;              // frames sent in the last `window`
+  std::optional<StepDown> last_step_down_;  // not yet judged
+  bool step_down_helped_ = false;           // a step down since the top was judged and kept
+  std::optional<TimePoint> no_step_down_until_;
+  int slow_client_backoff_ = 1;             // doubles per step down taken back
 
   std::optional<TimePoint> last_damage_;
   bool low_frame_on_screen_ = false;  // the last frame went out below the top and was not refreshed

@@ -165,7 +165,8 @@ std::optional<QualityLevel> ClientStreamer::tight_quality() const {
 }
 
 void ClientStreamer::offer_frame(TimePoint now, bool held) {
-  if (!config_.adaptive_quality) return;
+  // H.264's bitrate follows the link by its own cap (send_h264): the JPEG ladder has nothing to say there.
+  if (!config_.adaptive_quality || h264_) return;
   // While the window is still in slow start, a held frame says the window is small, not the link slow.
   quality_.frame_offered(now, held && !congestion_.in_slow_start());
   quality_.adjust(now, congestion_.path_rate());
@@ -184,9 +185,11 @@ bool ClientStreamer::use_h264() {
   switch (config_.codec) {
     case Codec::kJpeg: return false;
     case Codec::kH264: break;
-    // Switch once the link could not carry the top JPEG quality; stay, since H.264 is what made it fit.
+    // Switch once the link could not carry the top JPEG quality: a step down that helped, since a client that
+    // is slow per picture gains nothing from fewer bytes (and decoding H.264 may be slower still: Firefox);
+    // stay, since H.264 is what made it fit.
     case Codec::kAuto:
-      if (quality_.level() == 0) return false;
+      if (!quality_.link_bound()) return false;
       break;
   }
   try {
@@ -197,6 +200,8 @@ bool ClientStreamer::use_h264() {
     return false;
   }
   h264_ = true;
+  // The ladder applies to Tight only; should H.264 fail later, Tight starts again from the top.
+  quality_ = AdaptiveQuality(quality_config(config_));
   return true;
 }
 
@@ -248,7 +253,6 @@ ClientStreamer::Sent ClientStreamer::send_h264(rfbClientPtr client, TimePoint no
   sent.encode = Clock::now() - started;
   protocol_.position += message.size();
   congestion_.update_position(now, protocol_.position);
-  quality_.frame_sent(now, message.size());
   return sent;
 }
 

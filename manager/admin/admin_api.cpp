@@ -53,6 +53,7 @@ Json session_object(const Session& s, bool include_token) {
   json["codec"] = watched ? text_or_null(s.stream->codec) : Json(nullptr);
   json["rtt_ms"] = one_decimal(watched ? s.stream->rtt_ms : std::nullopt);
   json["fps"] = one_decimal(watched ? s.stream->fps : std::nullopt);
+  json["quality"] = watched && s.stream->quality ? Json(*s.stream->quality) : Json(nullptr);
   if (include_token) json["token"] = s.token;
   return json;
 }

@@ -152,6 +152,13 @@ std::string Metrics::render(const std::map<SessionState, std::int64_t>& sessions
       out += "rfbsim_session_fps{" + session_label(s) + "} " + number(*s.report.fps) + "\n";
     }
   }
+  header(out, "rfbsim_session_quality", "gauge",
+         "The JPEG quality of the session's picture stream now (Tight), or the configured level (H.264).");
+  for (const SessionStream& s : streams) {
+    if (s.report.clients > 0 && s.report.quality) {
+      out += "rfbsim_session_quality{" + session_label(s) + "} " + std::to_string(*s.report.quality) + "\n";
+    }
+  }
   header(out, "rfbsim_session_codec_info", "gauge", "The encoding of the session's picture stream (tight, h264, zrle, hextile, raw ...): 1.");
   for (const SessionStream& s : streams) {
     if (s.report.clients > 0 && !s.report.codec.empty()) {

@@ -92,7 +92,7 @@ class Metrics {
 
   /// The exposition text. `sessions_by_state`: live sessions by state now, and ended ones by state over
   /// the whole index; `relays`: WebSocket relays open now; `streams`: live sessions' streams, for
-  /// rfbsim_session_rtt_ms, rfbsim_session_fps and rfbsim_session_codec_info (each series only where known).
+  /// rfbsim_session_rtt_ms, rfbsim_session_fps, rfbsim_session_quality and rfbsim_session_codec_info (each series only where known).
   [[nodiscard]] std::string render(const std::map<SessionState, std::int64_t>& sessions_by_state, int capacity,
                                    RelayCounts relays, const std::vector<SessionStream>& streams = {}) const;
 

@@ -233,3 +233,55 @@ TEST_CASE("a still picture sent below the top is refreshed once", "[adaptive_qua
     CHECK(s.aq.wants_still_refresh(t + 4s + 800ms));
   }
 }
+
+namespace {
+
+// A client that takes `per_frame` to show each picture whatever its size (a page decoding slowly, a busy
+// laptop), behind a sender that holds a frame while the client still has one waiting, as congestion control
+// does once its answers come late: offered at 25 fps, it takes what it can and the rest is held.
+struct SlowClient {
+  std::chrono::milliseconds per_frame;
+  TimePoint free_at = t_start;
+  int ticks_at_top = 0;
+
+  void run(Stream& s, int ticks) {
+    for (int k = 0; k < ticks; ++k) {
+      const bool held = free_at > s.now() + per_frame;
+      if (!held) free_at = std::max(free_at, s.now()) + per_frame;
+      ticks_at_top += s.aq.level() == 0 ? 1 : 0;
+      s.frame(held, 20000 - 3000 * s.aq.level(), 0);
+    }
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a client slow per picture keeps the top quality: a step down that sends no more frames is taken back",
+          "[adaptive_quality]") {
+  Stream s;
+  SlowClient client{60ms};  // 16.7 of the 25 frames a second; a third held at every level
+  client.run(s, 3000);      // two minutes
+  // Down at 1.52 s, back after the hold-off (no more frames went out); the next try waits 30 s (750 ticks),
+  // and the one after it 60 s.
+  CHECK(s.changes == std::vector<int>{38, 76, 826, 864, 2364, 2402});
+  CHECK(client.ticks_at_top >= 0.9 * 3000);
+  CHECK_FALSE(s.aq.link_bound());
+}
+
+TEST_CASE("a slow link steps down while each step sends more frames, and the step counts as the link's",
+          "[adaptive_quality]") {
+  Stream s;
+  // 200 KB/s: 10 fps at the top, 14 at level 1, 18 at level 2, and level 3 (7 KB) carries all 25.
+  BorderlineLink link{200000, {20000, 14000, 11000, 7000, 5000}};
+  link.run(s, 39);
+  CHECK(s.aq.level() == 1);
+  CHECK_FALSE(s.aq.link_bound());  // not yet judged
+  link.run(s, 77 - 39);
+  CHECK(s.aq.level() == 2);
+  CHECK(s.aq.link_bound());  // the first step sent more frames: judged, kept, and the next one taken
+  CHECK_FALSE(s.aq.client_bound(s.now()));
+  link.run(s, 400);
+  CHECK(s.aq.level() == 3);
+  CHECK(s.aq.link_bound());
+  CHECK(s.changes == std::vector<int>{38, 76, 115});
+}

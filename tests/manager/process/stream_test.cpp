@@ -109,6 +109,11 @@ TEST_CASE("a session's stream reaches the admin API and the metrics while a clie
     CHECK(manager.metric("rfbsim_session_fps" + label + "}") > 0);
     CHECK(manager.metric("rfbsim_session_codec_info" + label + ",codec=\"tight\"}") == 1);
     CHECK(manager.metric("rfbsim_session_rtt_ms" + label + "}") == -1);
+    // Tight's JPEG quality, as sim_rfb reported it.
+    REQUIRE(session["quality"].is_number_integer());
+    CHECK(session["quality"].get<int>() >= 1);
+    CHECK(session["quality"].get<int>() <= 100);
+    CHECK(manager.metric("rfbsim_session_quality" + label + "}") == session["quality"].get<int>());
     client.send_key('w', false);
   }
 
@@ -116,6 +121,8 @@ TEST_CASE("a session's stream reaches the admin API and the metrics while a clie
   REQUIRE(await_session(manager, token, nullptr, [](const nlohmann::json& s) { return s["codec"].is_null(); },
                         session));
   CHECK(session["fps"].is_null());
+  CHECK(session["quality"].is_null());
+  CHECK(manager.metric("rfbsim_session_quality" + label + "}") == -1);
   CHECK(manager.metric("rfbsim_session_codec_info" + label + ",codec=\"tight\"}") == -1);
 }
 

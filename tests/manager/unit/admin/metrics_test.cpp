@@ -67,9 +67,10 @@ TEST_CASE("every series has its HELP and TYPE") {
                                                "# TYPE rfbsim_connection_addresses gauge",
                                                "# TYPE rfbsim_session_rtt_ms gauge",
                                                "# TYPE rfbsim_session_fps gauge",
+                                               "# TYPE rfbsim_session_quality gauge",
                                                "# TYPE rfbsim_session_codec_info gauge",
                                            });
-  CHECK(lines_starting(text, "# HELP ").size() == 17);
+  CHECK(lines_starting(text, "# HELP ").size() == 18);
 }
 
 TEST_CASE("sessions are listed for every state, zero included") {
