@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "app/frame_painter.hpp"
+#include "app/frame_schedule.hpp"
 #include "app/options.hpp"
 #include "app/parent_pipe.hpp"
 #include "app/ros_link.hpp"
@@ -353,7 +354,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   std::optional<StreamReporter> stream_reporter;
   if (options.ready_fd) stream_reporter.emplace(*options.ready_fd);
   auto last = Clock::now();
-  auto next_frame = last;
+  sim::FrameSchedule frames(frame_interval);
   bool outcome_reported = false;
   bool bag_failure_told = false;
   std::string end_reason = "signal";
@@ -374,6 +375,7 @@ int run(const rfbsim::sim::SimOptions& options) {
                                   change.client.websocket);
       }
     }
+    const sim::ControlState controls_before = simulation.controls();
     for (const rfbsim::InputEvent& event : server.poll_input()) {
       if (event.kind == rfbsim::InputEvent::Kind::Key) {
         study.key(event.keysym, event.down, event.client_id);
@@ -381,6 +383,8 @@ int run(const rfbsim::sim::SimOptions& options) {
         study.pointer(event.x, event.y, event.buttons, event.client_id);
       }
     }
+    // A held key's repeats change nothing: only a press or release that did is worth an early frame.
+    if (simulation.controls() != controls_before) frames.controls_changed();
     // An external controller's commands, like keys, are recorded at this tick and drive from the next. Only the
     // last one taken now can matter (each replaces the one before), so only it is recorded: a controller that
     // floods /cmd_vel costs no disk, and the replay is the same.
@@ -432,16 +436,10 @@ int run(const rfbsim::sim::SimOptions& options) {
     }
     if (stream_reporter) stream_reporter->update(now, clients, server);
 
-    // Render only for a viewer, at the frame rate.
-    if (clients == 0) {
-      next_frame = now;
-    } else if (now >= next_frame) {
-      draw_if_changed();
-      next_frame += frame_interval;
-      if (next_frame < now) next_frame = now + frame_interval;  // fell behind: skip, do not burst
-    }
+    // Render only for a viewer: at the frame rate, and early for a change of controls (FrameSchedule).
+    if (frames.render_now(now, ticks, clients > 0)) draw_if_changed();
     auto wake = now + clock.until_next_step();
-    if (clients > 0) wake = std::min(wake, next_frame);
+    if (clients > 0) wake = std::min(wake, frames.next_frame());
     std::this_thread::sleep_until(wake);
   }
   study.finish(end_reason);
