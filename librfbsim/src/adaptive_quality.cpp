@@ -121,6 +121,7 @@ bool AdaptiveQuality::judge_step_down(TimePoint now, bool too_many_held) {
   const StepDown step = *std::exchange(last_step_down_, std::nullopt);
   if (!too_many_held || sent_fps() >= config_.useful_gain * step.sent_fps) {
     step_down_helped_ = true;
+    slow_client_backoff_ = 1;  // the link is the limit now: a slow client later is a new finding
     return false;
   }
   change_level(now, step.from);
