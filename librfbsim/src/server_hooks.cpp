@@ -125,13 +125,17 @@ void Server::Impl::on_pointer(int mask, int x, int y, rfbClientPtr cl) {
   self.input.push(event);
 }
 
+detail::ClientQualityRequest Server::Impl::requested_quality(rfbClientPtr cl) {
+  return {cl->tightQualityLevel, cl->turboQualityLevel, cl->turboSubsampLevel, cl->tightCompressLevel};
+}
+
 void Server::Impl::on_update_start(rfbClientPtr cl) {
   auto* state = static_cast<ClientState*>(cl->clientData);
   if (state == nullptr) return;
   state->update_started = Clock::now();
   state->bytes_before_update = rfbStatGetSentBytes(cl);
   // What the client asked for (its latest SetEncodings, as libvncserver parsed it): the top of its ladder.
-  state->asked = {cl->tightQualityLevel, cl->turboQualityLevel, cl->turboSubsampLevel, cl->tightCompressLevel};
+  state->asked = requested_quality(cl);
   state->streamer.client_requested(state->asked);
   // Impose the server's JPEG quality and subsampling on Tight clients, capped by the client's request; the
   // client's streamer lowers it while its link cannot carry the frame rate. Undone in on_update_done.

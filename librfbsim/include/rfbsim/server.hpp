@@ -50,7 +50,7 @@ struct ClientStreamStatus {
   std::uint64_t updates_sent = 0;   ///< framebuffer updates sent to this client
   std::uint64_t updates_held = 0;   ///< new frames held back because the link was full (they coalesce)
   std::uint64_t update_requests = 0;  ///< FramebufferUpdateRequests received (few once continuous)
-  int quality = 0;                  ///< JPEG quality in use (Tight), or the configured one (H.264); 0 = none applies
+  int quality = 0;                  ///< JPEG quality in use (Tight), or the top one (H.264); 0 = none applies
   int quality_level = 0;            ///< 0 = the top (the configured quality, or the client's lower one); each step
                                     ///< down is one more
   /// JPEG quality 1..100 the client asked for (a Tight quality level through libvncserver's table, or TurboVNC's
