@@ -12,7 +12,7 @@
 //            and digits; left out when the server names none)
 //   rtt_ms   the latest round trip measured with fences, ms, one decimal; -1 while none was measured
 //   fps      updates per second over about the last second, one decimal
-//   quality  the JPEG quality in use 1..100 (Tight), or the configured one (H.264); left out where none
+//   quality  the JPEG quality in use 1..100 (Tight), or the top one (H.264); left out where none
 //            applies (ZRLE, Hextile, Raw and the other lossless encodings)
 //   requested  the JPEG quality 1..100 the participant's viewer asked for (a Tight quality level, e.g.
 //            TigerVNC's -QualityLevel or noVNC's ?quality=), which caps quality; left out when it asked none
