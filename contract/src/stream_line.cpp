@@ -67,6 +67,10 @@ bool apply_stream_value(std::string_view key, std::string_view value, StreamRepo
     report.fps = stream_decimal(value, 0, kMaxStreamFps);
     return report.fps.has_value();
   }
+  if (key == "requested") {
+    report.requested = stream_whole(value, 0, kMaxStreamQuality);
+    return report.requested.has_value();
+  }
   // quality
   report.quality = stream_whole(value, 0, kMaxStreamQuality);
   return report.quality.has_value();
@@ -94,7 +98,12 @@ std::string stream_line(const StreamReport& report) {
   if (report.quality) {
     std::snprintf(quality, sizeof quality, " quality=%d", std::clamp(*report.quality, 0, kMaxStreamQuality));
   }
-  return line + rtt + fps + quality + " clients=" + std::to_string(clients) + "\n";
+  // The viewer's own request, where it made one: 14 bytes at most, so the longest line stays under 100.
+  char requested[32] = "";
+  if (report.requested) {
+    std::snprintf(requested, sizeof requested, " requested=%d", std::clamp(*report.requested, 0, kMaxStreamQuality));
+  }
+  return line + rtt + fps + quality + requested + " clients=" + std::to_string(clients) + "\n";
 }
 
 bool is_stream_line(std::string_view line) {
@@ -108,7 +117,7 @@ StreamParse parse_stream_line(std::string_view line) {
     out.error = "not a stream line";
     return out;
   }
-  static const std::set<std::string_view> known = {"clients", "codec", "rtt_ms", "fps", "quality"};
+  static const std::set<std::string_view> known = {"clients", "codec", "rtt_ms", "fps", "quality", "requested"};
   StreamReport report;
   std::set<std::string_view> seen;
   // Pairs are separated by spaces; runs of spaces and a trailing carriage return are let pass.

@@ -21,6 +21,10 @@ struct ClientState {
   std::optional<std::chrono::steady_clock::time_point> backed_up_since;  // output above the unsent limit since
   std::chrono::steady_clock::time_point update_started{};
   int bytes_before_update = 0;
+  // The client's own quality fields as libvncserver parsed them, kept across each update: the update hook
+  // imposes ours in rfbClientRec for the update and puts these back afterwards, so that rfbClientRec always
+  // holds the client's request between updates (a later SetEncodings overwrites it there).
+  ClientQualityRequest asked;
   ClientStreamer streamer;  // negotiation, congestion control, quality and codec of this client's updates
 };
 

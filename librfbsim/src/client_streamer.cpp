@@ -157,11 +157,25 @@ ClientStreamer::Sent ClientStreamer::serve(rfbClientPtr client, TimePoint now, c
 
 std::optional<QualityLevel> ClientStreamer::tight_quality() const {
   if (config_.jpeg_quality <= 0) return std::nullopt;
-  // The top level keeps the configured subsampling; the ladder below it is 4:2:0.
-  const QualityLevel top{config_.jpeg_quality, config_.subsampling};
+  // The top level keeps the configured subsampling, lowered to what the client asked for; the ladder below it
+  // is 4:2:0 (or the client's coarser choice) and already starts at the client's quality (client_requested()).
+  const QualityLevel top = capped_by_client({config_.jpeg_quality, config_.subsampling}, request_);
   // Only pushed streams have the fences that tell a slow link apart from a slow client.
   if (!config_.adaptive_quality || !protocol_.continuous || still_refresh_ || quality_.level() == 0) return top;
-  return quality_.current();
+  return capped_by_client(quality_.current(), request_);
+}
+
+void ClientStreamer::client_requested(const ClientQualityRequest& request) {
+  if (request == request_) return;
+  request_ = request;
+  if (config_.jpeg_quality <= 0) return;
+  // The client's quality is the top of its ladder: the ladder is rebuilt (and starts at its top) when that
+  // top moves, as at a client's first SetEncodings or when TigerVNC's AutoSelect picks another level.
+  const int top = capped_by_client({config_.jpeg_quality, config_.subsampling}, request).jpeg_quality;
+  if (top == quality_.levels().front().jpeg_quality) return;
+  AdaptiveQualityConfig c = quality_config(config_);
+  c.top_quality = top;
+  quality_ = AdaptiveQuality(c);
 }
 
 void ClientStreamer::offer_frame(TimePoint now, bool held) {
@@ -310,6 +324,10 @@ ClientStreamStatus ClientStreamer::status(int id, TimePoint now, std::int32_t rf
   s.update_requests = protocol_.update_requests;
   const auto level = has_quality ? tight_quality() : std::nullopt;
   s.quality = level ? level->jpeg_quality : 0;
+  // What the client asked for, whether or not the server's cap let it have it.
+  s.requested_quality = request_.jpeg_quality >= 1 && request_.jpeg_quality <= 100 ? request_.jpeg_quality : 0;
+  s.requested_quality_level = request_.quality_level;
+  s.compress_level = request_.compress_level;
   s.quality_level =
       has_quality && protocol_.continuous && config_.adaptive_quality ? static_cast<int>(quality_.level()) : 0;
   s.delivery_mbit = congestion_.path_rate() * 8.0 / 1e6;

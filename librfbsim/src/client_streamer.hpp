@@ -15,6 +15,7 @@
 #include <string>
 
 #include "adaptive_quality.hpp"
+#include "client_quality.hpp"
 #include "congestion_control.hpp"
 #include "rfb_extension.hpp"
 #include "rfbsim/server.hpp"
@@ -64,8 +65,11 @@ class ClientStreamer {
   /// Sends the update that is due, if the client wants one and the link can take it.
   Sent serve(_rfbClientRec* client, TimePoint now, const std::uint8_t* framebuffer);
   /// Tight only: the JPEG quality and subsampling index to impose on the next update (nullopt = the
-  /// client's own level).
+  /// client's own level). Never above what the client asked for (client_requested()).
   [[nodiscard]] std::optional<QualityLevel> tight_quality() const;
+  /// What the client asked for in its latest SetEncodings (read by the server's update hook before each
+  /// update). Its JPEG quality, where lower than the server's, becomes the top of this client's ladder.
+  void client_requested(const ClientQualityRequest& request);
   /// Counts bytes written by a Tight update (from the server's update hooks) into the stream position.
   void tight_update_written(TimePoint now, std::uint64_t bytes);
   /// A snapshot for status pages.
@@ -84,6 +88,7 @@ class ClientStreamer {
   StreamingState protocol_;
   CongestionControl congestion_;
   AdaptiveQuality quality_;
+  ClientQualityRequest request_;          // the client's own quality and compression (client_quality.hpp)
   std::unique_ptr<H264Encoder> encoder_;  // created on the first H.264 update
   bool h264_ = false;                     // this client's updates are H.264 from now on
   bool h264_failed_ = false;              // the encoder could not be created: Tight for good

@@ -284,9 +284,11 @@ void Server::Impl::serve_clients(const std::vector<pollfd>& polled) {
       rfbProcessClientMessage(cl);
     }
     watchdog.disarm();
-    // What the messages negotiated (Fence, ContinuousUpdates) is announced once, after them.
+    // What the messages negotiated (Fence, ContinuousUpdates) is announced once, after them. A new quality
+    // request is taken at once too, so that the status shows it even for a client whose updates are H.264.
     if (cl->sock != RFB_INVALID_SOCKET && cl->clientData != nullptr) {
       watchdog.arm(state->guard_fd, Clock::now() + options.write_timeout);
+      static_cast<ClientState*>(cl->clientData)->streamer.client_requested(requested_quality(cl));
       static_cast<ClientState*>(cl->clientData)->streamer.after_messages(cl);
       watchdog.disarm();
     }

@@ -125,13 +125,20 @@ void Server::Impl::on_pointer(int mask, int x, int y, rfbClientPtr cl) {
   self.input.push(event);
 }
 
+detail::ClientQualityRequest Server::Impl::requested_quality(rfbClientPtr cl) {
+  return {cl->tightQualityLevel, cl->turboQualityLevel, cl->turboSubsampLevel, cl->tightCompressLevel};
+}
+
 void Server::Impl::on_update_start(rfbClientPtr cl) {
   auto* state = static_cast<ClientState*>(cl->clientData);
   if (state == nullptr) return;
   state->update_started = Clock::now();
   state->bytes_before_update = rfbStatGetSentBytes(cl);
-  // Impose the server's JPEG quality and subsampling on Tight clients, whatever level they asked for;
-  // the client's streamer lowers it while its link cannot carry the frame rate.
+  // What the client asked for (its latest SetEncodings, as libvncserver parsed it): the top of its ladder.
+  state->asked = requested_quality(cl);
+  state->streamer.client_requested(state->asked);
+  // Impose the server's JPEG quality and subsampling on Tight clients, capped by the client's request; the
+  // client's streamer lowers it while its link cannot carry the frame rate. Undone in on_update_done.
   if (const auto level = state->streamer.tight_quality()) {
     cl->turboQualityLevel = level->jpeg_quality;
     cl->turboSubsampLevel = level->subsampling;
@@ -151,6 +158,12 @@ void Server::Impl::on_update_done(rfbClientPtr cl, int /*result*/) {
   Impl& self = of(cl);
   auto* state = static_cast<ClientState*>(cl->clientData);
   if (state == nullptr) return;
+  // The client's own request back in place (libvncserver calls this hook on every path after on_update_start;
+  // its Tight encoder also clamps tightCompressLevel in place, which this undoes too).
+  cl->tightQualityLevel = state->asked.quality_level;
+  cl->turboQualityLevel = state->asked.jpeg_quality;
+  cl->turboSubsampLevel = state->asked.subsampling;
+  cl->tightCompressLevel = state->asked.compress_level;
   // libvncserver's byte counter is an int that wraps after 2 GiB: subtract as unsigned 32-bit.
   const std::uint32_t sent = static_cast<std::uint32_t>(rfbStatGetSentBytes(cl)) -
                              static_cast<std::uint32_t>(state->bytes_before_update);

@@ -102,6 +102,9 @@ struct Server::Impl {
   static void on_update_start(rfbClientPtr cl);
   static void on_update_done(rfbClientPtr cl, int result);
   static void on_update_request(rfbClientPtr cl, rfbFramebufferUpdateRequestMsg* request);
+  /// The quality and compression `cl` asked for in its latest SetEncodings, as libvncserver parsed them into its
+  /// rfbClientRec (valid between updates: on_update_done puts the client's values back after each).
+  static detail::ClientQualityRequest requested_quality(rfbClientPtr cl);
   void publish_streams(Clock::time_point now);
 
   ServerOptions options;

@@ -86,7 +86,7 @@ void declare_sim_options(CLI::App& app, SimOptions& o) {
       ->type_name("H")->capture_default_str()->transform(in_range(120, 2160));
   app.add_option("--fps", o.fps, "frames per second while someone watches")
       ->type_name("F")->capture_default_str()->transform(in_range(1, 120));
-  app.add_option("--quality", o.jpeg_quality, "JPEG quality")
+  app.add_option("--quality", o.jpeg_quality, "JPEG quality: the most any viewer gets (a viewer may ask for less)")
       ->type_name("Q")->capture_default_str()->transform(in_range(1, 100));
   cli::one_of(app.add_option("--codec", o.codec,
                              "picture encoding: auto (Tight JPEG, H.264 for a client that offers it once its\n"

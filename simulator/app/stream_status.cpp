@@ -27,6 +27,9 @@ std::string json_number(double value, int decimals) {
 // A round trip for JSON: null while not measured (the library says -1).
 std::string json_rtt(double ms) { return ms < 0 ? "null" : json_number(ms, 1); }
 
+// A level a client asked for, for JSON: null below `lowest` (the library's "none asked").
+std::string json_level(int level, int lowest) { return level < lowest ? "null" : std::to_string(level); }
+
 }  // namespace
 
 const rfbsim::ClientStreamStatus* main_stream(const std::vector<rfbsim::ClientStreamStatus>& streams) {
@@ -55,9 +58,13 @@ std::string streams_json(const std::vector<rfbsim::ClientStreamStatus>& streams)
             ",\"updates_held\":" + std::to_string(s.updates_held) +
             ",\"update_requests\":" + std::to_string(s.update_requests) +
             // A quality only where one applies (Tight's JPEG, H.264): ZRLE, Hextile and Raw are lossless.
+            // What the client asked for beside it: null when it named no quality (the server's then applies).
             (s.quality > 0 ? ",\"quality\":" + std::to_string(s.quality) +
-                                 ",\"quality_level\":" + std::to_string(s.quality_level)
+                                 ",\"quality_level\":" + std::to_string(s.quality_level) +
+                                 ",\"requested_quality\":" + json_level(s.requested_quality, 1) +
+                                 ",\"requested_quality_level\":" + json_level(s.requested_quality_level, 0)
                            : std::string()) +
+            ",\"compress_level\":" + std::to_string(s.compress_level) +
             ",\"delivery_mbit\":" + json_number(s.delivery_mbit, 2) + ",\"fps\":" + json_number(s.fps, 1) + "}";
   }
   return json + "]";
@@ -73,6 +80,7 @@ std::string stream_line(const std::vector<rfbsim::ClientStreamStatus>& streams) 
   if (participant->last_rtt_ms >= 0) report.rtt_ms = participant->last_rtt_ms;  // the library says -1 until measured
   report.fps = participant->fps;
   if (participant->quality > 0) report.quality = participant->quality;
+  if (participant->quality > 0 && participant->requested_quality > 0) report.requested = participant->requested_quality;
   return contract::stream_line(report);
 }
 

@@ -21,7 +21,9 @@ const rfbsim::ClientStreamStatus* main_stream(const std::vector<rfbsim::ClientSt
 
 /// The JSON array for /status.json's "streams": one object per client, in the order given, with the keys id,
 /// encoding, continuous_updates, fence, base_rtt_ms, last_rtt_ms (both null while not measured), window_bytes,
-/// in_flight_bytes, updates_sent, updates_held, quality, quality_level, delivery_mbit and fps.
+/// in_flight_bytes, updates_sent, updates_held, update_requests, quality, quality_level, requested_quality and
+/// requested_quality_level (these four only where a JPEG quality applies; the requested ones null when the client
+/// named none), compress_level, delivery_mbit and fps.
 std::string streams_json(const std::vector<rfbsim::ClientStreamStatus>& streams);
 
 /// The ready pipe's stream line for `streams` (rfbsim::contract::stream_line of the participant's stream and the

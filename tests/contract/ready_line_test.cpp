@@ -56,7 +56,7 @@ TEST_CASE("what each writer writes reads back as it was") {
   const auto incomplete = read_back(contract::data_incomplete_line("events.jsonl: No space left on device"));
   REQUIRE(incomplete.line);
   CHECK(std::get<contract::DataIncomplete>(*incomplete.line).reason == "events.jsonl: No space left on device");
-  const auto stream = read_back(contract::stream_line(contract::StreamReport{1, "tight", 12.5, 30, 80}));
+  const auto stream = read_back(contract::stream_line(contract::StreamReport{1, "tight", 12.5, 30, 80, std::nullopt}));
   REQUIRE(stream.line);
   CHECK(std::get<contract::StreamReport>(*stream.line).clients == 1);
 }

@@ -121,21 +121,29 @@ TEST_CASE("the writer gives sim_rfb's exact bytes") {
   using rfbsim::contract::StreamReport;
   using rfbsim::contract::stream_line;
   CHECK(stream_line(StreamReport{}) == "stream clients=0\n");
-  CHECK(stream_line(StreamReport{1, "tight", 12.54, 29.76, 80}) ==
+  CHECK(stream_line(StreamReport{1, "tight", 12.54, 29.76, 80, std::nullopt}) ==
         "stream codec=tight rtt_ms=12.5 fps=29.8 quality=80 clients=1\n");
   // Unmeasured round trip, no codec name, then values beyond their bounds: clamped, never a longer line.
-  CHECK(stream_line(StreamReport{2, "", std::nullopt, 0.0, 60}) == "stream rtt_ms=-1 fps=0.0 quality=60 clients=2\n");
-  CHECK(stream_line(StreamReport{123456, "Not A Codec", 1e12, 1.0 / 0.0, 500}) ==
+  CHECK(stream_line(StreamReport{2, "", std::nullopt, 0.0, 60, std::nullopt}) == "stream rtt_ms=-1 fps=0.0 quality=60 clients=2\n");
+  CHECK(stream_line(StreamReport{123456, "Not A Codec", 1e12, 1.0 / 0.0, 500, std::nullopt}) ==
         "stream rtt_ms=600000.0 fps=0.0 quality=100 clients=9999\n");
   // A lossless encoding has no quality: the key is left out rather than written as 0.
-  CHECK(stream_line(StreamReport{1, "zrle", 3.0, 15.0, std::nullopt}) == "stream codec=zrle rtt_ms=3.0 fps=15.0 clients=1\n");
+  CHECK(stream_line(StreamReport{1, "zrle", 3.0, 15.0, std::nullopt, std::nullopt}) == "stream codec=zrle rtt_ms=3.0 fps=15.0 clients=1\n");
+  // The viewer's own request (TigerVNC's -QualityLevel=3), after the quality in use; clamped like it.
+  CHECK(stream_line(StreamReport{1, "tight", 3.1, 30.0, 42, 42}) ==
+        "stream codec=tight rtt_ms=3.1 fps=30.0 quality=42 requested=42 clients=1\n");
+  // The longest line there can be stays under 100 bytes (one atomic write to a pipe).
+  CHECK(stream_line(StreamReport{9999, "abcdefghijklmnop", 1e12, 1e12, 500, 500}) ==
+        "stream codec=abcdefghijklmnop rtt_ms=600000.0 fps=1000.0 quality=100 requested=100 clients=9999\n");
+  CHECK(stream_line(StreamReport{9999, "abcdefghijklmnop", 1e12, 1e12, 500, 500}).size() < 100);
 }
 
 TEST_CASE("what the writer writes reads back as it was") {
   using rfbsim::contract::StreamReport;
-  for (const StreamReport& written : {StreamReport{1, "h264", 52.3, 29.7, 80}, StreamReport{3, "", std::nullopt, 0.5, 1},
-                                      StreamReport{9999, "tight", 0.0, 1000.0, 100},
-                                      StreamReport{1, "zrle", 2.5, 15.0, std::nullopt}}) {
+  for (const StreamReport& written : {StreamReport{1, "h264", 52.3, 29.7, 80, std::nullopt}, StreamReport{3, "", std::nullopt, 0.5, 1, std::nullopt},
+                                      StreamReport{9999, "tight", 0.0, 1000.0, 100, std::nullopt},
+                                      StreamReport{1, "zrle", 2.5, 15.0, std::nullopt, std::nullopt},
+                                      StreamReport{1, "tight", 3.1, 30.0, 42, 42}}) {
     std::string line = rfbsim::contract::stream_line(written);
     REQUIRE(line.back() == '\n');
     line.pop_back();
@@ -146,6 +154,8 @@ TEST_CASE("what the writer writes reads back as it was") {
     CHECK(read.report->rtt_ms == written.rtt_ms);
     CHECK(read.report->fps == written.fps);
     CHECK(read.report->quality == written.quality);
+    CHECK(read.report->requested == written.requested);
   }
+  CHECK(parse_stream_line("stream quality=42 requested=101 clients=1").error == "bad value '101' for requested");
   CHECK(parse_stream_line("stream clients=10000").report == std::nullopt);  // the writer's bound is the reader's
 }

@@ -261,10 +261,16 @@ TEST_CASE("/status.json lists each viewer's stream: encoding, ContinuousUpdates,
     CHECK_THAT(streams, Catch::Contains(R"("last_rtt_ms":null)"));
     CHECK(json_number(streams, "quality") >= 1);
     CHECK(json_number(streams, "quality") <= 100);
+    // libvncclient asks for quality level 8 (JPEG 92) and compress level 1: shown as asked, the quality capped.
+    CHECK(json_number(streams, "requested_quality_level") == 8);
+    CHECK(json_number(streams, "requested_quality") == 92);
+    CHECK(json_number(streams, "quality") <= 80);
+    CHECK(json_number(streams, "compress_level") == 1);
     // Every key, once.
     for (const char* key : {"id", "encoding", "continuous_updates", "fence", "base_rtt_ms", "last_rtt_ms",
                             "window_bytes", "in_flight_bytes", "updates_sent", "updates_held", "update_requests", "quality",
-                            "quality_level", "delivery_mbit", "fps"}) {
+                            "quality_level", "requested_quality", "requested_quality_level", "compress_level",
+                            "delivery_mbit", "fps"}) {
       CHECK(streams.find("\"" + std::string(key) + "\":") != std::string::npos);
     }
   }
@@ -447,8 +453,10 @@ TEST_CASE("sim_rfb tells its parent the viewer's stream on the ready pipe about 
   {
     RfbTestClient client("127.0.0.1", std::stoi(ready_match[1]));
     client.send_key('w', true);  // a moving picture, so that updates keep coming
-    // The participant's stream: libvncclient asks for each update, so Tight and no measured round trip.
-    const std::regex watched(R"(stream codec=tight rtt_ms=-1 fps=([0-9]+\.[0-9]) quality=([0-9]+) clients=1
+    // The participant's stream: libvncclient asks for each update, so Tight and no measured round trip; it asks
+    // for quality level 8 (requested=92), above the server's 80.
+    const std::regex watched(
+        R"(stream codec=tight rtt_ms=-1 fps=([0-9]+\.[0-9]) quality=([0-9]+) requested=([0-9]+) clients=1
 )");
     REQUIRE(await_line(&client, watched, lines));
     // A second later, another.
@@ -463,6 +471,7 @@ TEST_CASE("sim_rfb tells its parent the viewer's stream on the ready pipe about 
     CHECK(std::stod(match[1]) > 0.0);   // updates flow
     CHECK(std::stod(match[1]) <= 40.0);  // about the frame rate (20), give or take the second's edges
     CHECK(std::stoi(match[2]) == 80);    // the default quality
+    CHECK(std::stoi(match[3]) == 92);    // level 8 through libvncserver's table: capped by the 80
     lines += more;
     client.send_key('w', false);
   }

@@ -4,6 +4,7 @@
 // /metrics):
 //
 //   stream codec=tight rtt_ms=12.5 fps=29.8 quality=80 clients=1
+//   stream codec=tight rtt_ms=3.1 fps=30.0 quality=42 requested=42 clients=1
 //   stream clients=0
 //
 // Space-separated key=value pairs after the word "stream", in this order:
@@ -11,8 +12,10 @@
 //            and digits; left out when the server names none)
 //   rtt_ms   the latest round trip measured with fences, ms, one decimal; -1 while none was measured
 //   fps      updates per second over about the last second, one decimal
-//   quality  the JPEG quality in use 1..100 (Tight), or the configured one (H.264); left out where none
+//   quality  the JPEG quality in use 1..100 (Tight), or the top one (H.264); left out where none
 //            applies (ZRLE, Hextile, Raw and the other lossless encodings)
+//   requested  the JPEG quality 1..100 the participant's viewer asked for (a Tight quality level, e.g.
+//            TigerVNC's -QualityLevel or noVNC's ?quality=), which caps quality; left out when it asked none
 //   clients  how many viewers are connected; with 0 no other key follows
 // Readers ignore keys they do not know: later versions may add some. docs/deployment.md describes it too.
 #pragma once
@@ -36,6 +39,7 @@ struct StreamReport {
   std::optional<double> rtt_ms;   ///< the latest round trip, ms (0..600000); unset = not measured (-1 on the line)
   std::optional<double> fps;      ///< updates per second over about the last second (0..1000)
   std::optional<int> quality;     ///< JPEG quality in use (0..100); unset where none applies (ZRLE, Raw ...)
+  std::optional<int> requested;   ///< JPEG quality the viewer asked for (0..100); unset = it asked none
 };
 
 /// The outcome of parsing a line: a report, or what is wrong with it.
@@ -50,7 +54,7 @@ bool is_codec_name(std::string_view name);
 
 /// The line for `report`, newline included; under 100 bytes, so that one write() of it to a pipe is atomic.
 /// clients 0 gives "stream clients=0\n". Otherwise codec is left out when it is not a codec name, rtt_ms is -1
-/// when unset, fps and quality are 0 when unset, and every number is clamped to its bound (a non-finite one
+/// when unset, fps is 0 when unset, quality and requested are left out when unset, and every number is clamped to its bound (a non-finite one
 /// to 0).
 std::string stream_line(const StreamReport& report);
 
@@ -58,7 +62,7 @@ std::string stream_line(const StreamReport& report);
 bool is_stream_line(std::string_view line);
 
 /// Parses a stream line: "stream" then space-separated key=value pairs. `clients` is required; `codec`,
-/// `rtt_ms`, `fps` and `quality` are optional; keys this version does not know are ignored (a newer sim_rfb may
+/// `rtt_ms`, `fps`, `quality` and `requested` are optional; keys this version does not know are ignored (a newer sim_rfb may
 /// add some). A pair without '=', a key given twice, or a value out of its range or not a plain number is an
 /// error naming it, and nothing of the line is taken. Never throws.
 StreamParse parse_stream_line(std::string_view line);

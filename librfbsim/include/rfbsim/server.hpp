@@ -50,8 +50,14 @@ struct ClientStreamStatus {
   std::uint64_t updates_sent = 0;   ///< framebuffer updates sent to this client
   std::uint64_t updates_held = 0;   ///< new frames held back because the link was full (they coalesce)
   std::uint64_t update_requests = 0;  ///< FramebufferUpdateRequests received (few once continuous)
-  int quality = 0;                  ///< JPEG quality in use (Tight), or the configured one (H.264); 0 = none applies
-  int quality_level = 0;            ///< 0 = the configured quality; each step down is one more
+  int quality = 0;                  ///< JPEG quality in use (Tight), or the top one (H.264); 0 = none applies
+  int quality_level = 0;            ///< 0 = the top (the configured quality, or the client's lower one); each step
+                                    ///< down is one more
+  /// JPEG quality 1..100 the client asked for (a Tight quality level through libvncserver's table, or TurboVNC's
+  /// fine level); 0 = it asked none. `quality` never exceeds it, nor the server's jpeg_quality.
+  int requested_quality = 0;
+  int requested_quality_level = -1;  ///< the Tight quality level 0..9 the client asked for; -1 = none
+  int compress_level = 6;           ///< the Tight zlib level 0..9 the client asked for (libvncserver's 6 if none)
   double delivery_mbit = 0;         ///< the link's measured rate while full, Mbit/s; 0 = unknown
   double fps = 0;                   ///< updates per second over the last second or so
 };

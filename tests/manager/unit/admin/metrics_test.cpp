@@ -186,9 +186,9 @@ TEST_CASE("rejection reasons have their label names") {
 TEST_CASE("each watched session's stream is a series labelled with its id, and only what is known") {
   const Metrics metrics;
   const std::vector<SessionStream> streams = {
-      {12, StreamReport{1, "h264", 52.3, 29.7, 80}},
-      {3, StreamReport{2, "tight", std::nullopt, 15, 60}},  // a client without fences: no round trip
-      {7, StreamReport{0, "tight", 10, 30, 80}},            // nobody watches any more: no series
+      {12, StreamReport{1, "h264", 52.3, 29.7, 80, std::nullopt}},
+      {3, StreamReport{2, "tight", std::nullopt, 15, 60, std::nullopt}},  // a client without fences: no round trip
+      {7, StreamReport{0, "tight", 10, 30, 80, std::nullopt}},            // nobody watches any more: no series
   };
   const std::string text = metrics.render({}, 4, {}, streams);
   CHECK(lines_starting(text, "rfbsim_session_rtt_ms{") == std::vector<std::string>{
@@ -211,6 +211,6 @@ TEST_CASE("each watched session's stream is a series labelled with its id, and o
 }
 
 TEST_CASE("a label value that is not plain cannot break the exposition text") {
-  const std::string text = Metrics().render({}, 4, {}, {{5, StreamReport{1, "a\"b\\c\nd", 1, 1, 1}}});
+  const std::string text = Metrics().render({}, 4, {}, {{5, StreamReport{1, "a\"b\\c\nd", 1, 1, 1, std::nullopt}}});
   CHECK(has_line(text, R"(rfbsim_session_codec_info{session="5",codec="a\"b\\c\nd"} 1)"));
 }

@@ -111,7 +111,7 @@ TEST_CASE("the admin API's session JSON carries the participant's stream while s
     return json.substr(json.find(R"("codec")"));
   };
   CHECK(stream_part() == R"("codec":null,"rtt_ms":null,"fps":null})");
-  s.stream = rfbsim::manager::StreamReport{1, "h264", 52.34, 29.66, 80};
+  s.stream = rfbsim::manager::StreamReport{1, "h264", 52.34, 29.66, 80, std::nullopt};
   CHECK(stream_part() == R"("codec":"h264","rtt_ms":52.3,"fps":29.7})");
   // A stream without a measured round trip (a client without fences) says so with null.
   s.stream->rtt_ms.reset();
