@@ -165,17 +165,24 @@ std::optional<QualityLevel> ClientStreamer::tight_quality() const {
   return capped_by_client(quality_.current(), request_);
 }
 
+int ClientStreamer::client_top_quality() const {
+  return capped_by_client({config_.jpeg_quality, config_.subsampling}, request_).jpeg_quality;
+}
+
+AdaptiveQualityConfig ClientStreamer::client_ladder_config() const {
+  AdaptiveQualityConfig c = quality_config(config_);
+  c.top_quality = client_top_quality();
+  return c;
+}
+
 void ClientStreamer::client_requested(const ClientQualityRequest& request) {
   if (request == request_) return;
   request_ = request;
   if (config_.jpeg_quality <= 0) return;
   // The client's quality is the top of its ladder: the ladder is rebuilt (and starts at its top) when that
   // top moves, as at a client's first SetEncodings or when TigerVNC's AutoSelect picks another level.
-  const int top = capped_by_client({config_.jpeg_quality, config_.subsampling}, request).jpeg_quality;
-  if (top == quality_.levels().front().jpeg_quality) return;
-  AdaptiveQualityConfig c = quality_config(config_);
-  c.top_quality = top;
-  quality_ = AdaptiveQuality(c);
+  if (client_top_quality() == quality_.levels().front().jpeg_quality) return;
+  quality_ = AdaptiveQuality(client_ladder_config());
 }
 
 void ClientStreamer::offer_frame(TimePoint now, bool held) {
@@ -214,8 +221,8 @@ bool ClientStreamer::use_h264() {
     return false;
   }
   h264_ = true;
-  // The ladder applies to Tight only; should H.264 fail later, Tight starts again from the top.
-  quality_ = AdaptiveQuality(quality_config(config_));
+  // The ladder applies to Tight only; should H.264 fail later, Tight starts again from the (client's) top.
+  quality_ = AdaptiveQuality(client_ladder_config());
   return true;
 }
 

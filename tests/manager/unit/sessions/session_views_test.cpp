@@ -99,7 +99,7 @@ TEST_CASE("the admin API's session JSON names every field, and the token only wh
       R"("ended_at":null,"data_path":"/data/sessions/7-p-01","outcome":null,)"
       R"("copy_state":"","copy_attempts":0,"copy_error":"",)"
       R"("params":{"uid":"p-01","scenario":"lab","seed":"42"},"ros_namespace":null,"robot_control":null,)"
-      R"("codec":null,"rtt_ms":null,"fps":null)";
+      R"("codec":null,"rtt_ms":null,"fps":null,"quality":null)";
   CHECK(rfbsim::manager::admin_session_json(s, false) == expected + "}");
   CHECK(rfbsim::manager::admin_session_json(s, true) == expected + R"(,"token":"0123456789abcdef0123456789abcdef"})");
 }
@@ -110,16 +110,21 @@ TEST_CASE("the admin API's session JSON carries the participant's stream while s
     const std::string json = rfbsim::manager::admin_session_json(s, false);
     return json.substr(json.find(R"("codec")"));
   };
-  CHECK(stream_part() == R"("codec":null,"rtt_ms":null,"fps":null})");
+  CHECK(stream_part() == R"("codec":null,"rtt_ms":null,"fps":null,"quality":null})");
   s.stream = rfbsim::manager::StreamReport{1, "h264", 52.34, 29.66, 80, std::nullopt};
-  CHECK(stream_part() == R"("codec":"h264","rtt_ms":52.3,"fps":29.7})");
+  CHECK(stream_part() == R"("codec":"h264","rtt_ms":52.3,"fps":29.7,"quality":80})");
   // A stream without a measured round trip (a client without fences) says so with null.
   s.stream->rtt_ms.reset();
   s.stream->codec = "tight";
-  CHECK(stream_part() == R"("codec":"tight","rtt_ms":null,"fps":29.7})");
+  CHECK(stream_part() == R"("codec":"tight","rtt_ms":null,"fps":29.7,"quality":80})");
+  // A lossless encoding has no quality.
+  s.stream->codec = "zrle";
+  s.stream->quality.reset();
+  CHECK(stream_part() == R"("codec":"zrle","rtt_ms":null,"fps":29.7,"quality":null})");
   // Nobody watching: nothing to show, whatever was reported before.
+  s.stream->quality = 80;
   s.stream->clients = 0;
-  CHECK(stream_part() == R"("codec":null,"rtt_ms":null,"fps":null})");
+  CHECK(stream_part() == R"("codec":null,"rtt_ms":null,"fps":null,"quality":null})");
 }
 
 TEST_CASE("the session record beside the data says how the session ended, with no token") {
