@@ -107,7 +107,8 @@ function shown(selector) {
 // Chromium needs none: playwright talks to it through a pipe, and it exits when the pipe closes. Firefox is
 // talked to over a WebSocket and would stay. Returns a function that stops the guard (clean ends need it not).
 function startOrphanGuard(firefoxPid, profileDir) {
-  const script = 'while kill -0 "$1" 2>/dev/null; do sleep 1; done; kill -KILL -- "-$2" 2>/dev/null; rm -rf -- "$3"';
+  // dash's kill takes no -- after -KILL, only after -s KILL.
+  const script = 'while kill -0 "$1" 2>/dev/null; do sleep 1; done; kill -s KILL -- "-$2" 2>/dev/null; rm -rf -- "$3"';
   const guard = spawn('/bin/sh', ['-c', script, 'rfbsim-e2e-firefox-guard', String(process.pid), String(firefoxPid),
                                   profileDir], { detached: true, stdio: 'ignore' });
   guard.unref();

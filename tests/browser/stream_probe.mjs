@@ -10,7 +10,9 @@ import {
   getStatus, log, openPage, recordPage, sleep, startSim, stopSimCleanly, waitForConnection, waitForPicture,
 } from './e2e_support.mjs';
 
-const SAMPLES = 8;          // /status.json readings, one a second
+// /status.json readings, one a second. 8 keep the test short; RFBSIM_E2E_AUTO_CODEC_S=30 (say) watches longer,
+// for whoever studies the adaptive streaming (in one 30 s walk Firefox moved from Tight to H.264 after 24 s).
+const SAMPLES = Math.max(3, Number(process.env.RFBSIM_E2E_AUTO_CODEC_S) || 8);
 const WALK_FROM_SAMPLE = 2; // W is held from this reading to the last: a moving picture, as a participant's is
 
 // One viewer's stream as a short text: "tight q 80 (level 0), 24.0 fps, rtt 3.1 ms".
