@@ -352,6 +352,10 @@ export async function launchBrowser(chromium, viewport, contextOptions = {}) {
   return context;
 }
 
+// What Firefox says, as a script error of the page, when a WebSocket cannot connect or is cut while it loads.
+const FIREFOX_SOCKET_REPORT = new RegExp('^(Firefox can[\u2019\']t establish a connection to the server at wss?:' +
+                                         '|The connection to wss?:\\S+ was interrupted while the page was loading)');
+
 // Writes the page's console, uncaught errors, failed requests and HTTP errors to logPath. Returns
 // { pageErrors, badResponses, cspReports, close() }: the lists fill as the page runs (cspReports: the browser's
 // Content-Security-Policy refusals); close() resolves once the log is written out. Cleanup closes it too, if the
@@ -376,6 +380,12 @@ export function recordPage(page, logPath) {
     if (/^Content-Security-Policy:/.test(err.message)) {
       cspReports.push(err.message);
       write(`error (CSP): ${err.message}`);
+      return;
+    }
+    // The same for a WebSocket that could not connect or was cut (Chromium: "WebSocket connection to ... failed"
+    // on the console): the page sees it as the socket's error and close events, which it handles.
+    if (FIREFOX_SOCKET_REPORT.test(err.message)) {
+      write(`error (network): ${err.message}`);
       return;
     }
     pageErrors.push(err.message);
