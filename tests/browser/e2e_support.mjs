@@ -127,17 +127,34 @@ export async function poll(what, timeoutMs, intervalMs, fn) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
-// Arguments: SIM_RFB ARTIFACTS_DIR [WEB_DIR]. Prints the usage and exits 1 when they are missing.
+// Arguments: [--browser chromium|firefox] SIM_RFB ARTIFACTS_DIR [WEB_DIR]. Prints the usage and exits 1 when they
+// are missing.
 // ---------------------------------------------------------------------------------------------------------------
 
-// Returns { simPath, artifacts, webDir } with absolute artifacts and webDir (default: ../../web from here).
+// The command line's arguments without `--browser NAME`, and NAME (default chromium; null if not one we drive).
+function takeBrowserOption() {
+  const args = process.argv.slice(2);
+  let browser = 'chromium';
+  const option = args.indexOf('--browser');
+  if (option !== -1) {
+    browser = args[option + 1];
+    args.splice(option, 2);
+  }
+  return { args, browser: ['chromium', 'firefox'].includes(browser) ? browser : null };
+}
+
+// Returns { browser, simPath, artifacts, webDir } with absolute artifacts and webDir (default: ../../web from
+// here). Arguments: [--browser chromium|firefox] SIM_RFB ARTIFACTS_DIR [WEB_DIR]; only the tests that run in
+// either browser (browser_driver.mjs) read `browser`.
 export function parseArgs(scriptName) {
-  const [simPath, artifactsArg, webArg] = process.argv.slice(2);
-  if (!simPath || !artifactsArg) {
-    console.error(`usage: node ${scriptName} SIM_RFB ARTIFACTS_DIR [WEB_DIR]`);
+  const { args, browser } = takeBrowserOption();
+  const [simPath, artifactsArg, webArg] = args;
+  if (!simPath || !artifactsArg || !browser) {
+    console.error(`usage: node ${scriptName} [--browser chromium|firefox] SIM_RFB ARTIFACTS_DIR [WEB_DIR]`);
     process.exit(1);
   }
   return {
+    browser,
     simPath,
     artifacts: path.resolve(artifactsArg),
     webDir: path.resolve(webArg || path.join(here, '..', '..', 'web')),
@@ -148,15 +165,9 @@ export function parseArgs(scriptName) {
 // [WEB_DIR]. Returns { browser, simPath (sim_manager: what startSim starts), simRfbPath, webRoot, artifacts,
 // webDir }, paths absolute. Only the tests that run in either browser (browser_driver.mjs) read `browser`.
 export function parseManagerArgs(scriptName) {
-  const args = process.argv.slice(2);
-  let browser = 'chromium';
-  const option = args.indexOf('--browser');
-  if (option !== -1) {
-    browser = args[option + 1];
-    args.splice(option, 2);
-  }
+  const { args, browser } = takeBrowserOption();
   const [managerPath, simRfbPath, webRoot, artifactsArg, webArg] = args;
-  if (!managerPath || !simRfbPath || !webRoot || !artifactsArg || !['chromium', 'firefox'].includes(browser)) {
+  if (!managerPath || !simRfbPath || !webRoot || !artifactsArg || !browser) {
     console.error(`usage: node ${scriptName} [--browser chromium|firefox] SIM_MANAGER SIM_RFB WEB_ROOT ` +
                   'ARTIFACTS_DIR [WEB_DIR]');
     process.exit(1);
