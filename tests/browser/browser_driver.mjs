@@ -8,7 +8,7 @@
 // (profile, viewport, init scripts, HTTP credentials), elements by CSS selector (click, wait until shown or hidden,
 // text, attribute, enabled), the page's WebSockets, answering a request in the test's place, and how a frame the
 // browser refused looks. The Chromium driver does what the tests did before, through playwright's locators; the
-// Firefox one does the same with puppeteer, and reads what cannot be the same in its comments.
+// Firefox one does the same with puppeteer, and its comments say where the two cannot behave alike.
 
 import { spawn } from 'node:child_process';
 import fs from 'node:fs';
@@ -39,13 +39,11 @@ function chromiumDriver(webDir) {
   return {
     name: 'chromium',
 
-    // Resolves with { version, firstPage(), newPage(), addInitScript(fn) }. credentials: { username, password,
-    // origin } sent to that origin only when it asks (HTTP Basic), or undefined.
+    // Resolves with { firstPage(), newPage(), addInitScript(fn) }; cleanup (e2e_support.mjs) closes the browser.
+    // credentials: { username, password, origin } sent to that origin only when it asks (HTTP Basic), or undefined.
     async launch(viewport, { credentials } = {}) {
       const context = await launchBrowser(chromium, viewport, credentials ? { httpCredentials: credentials } : {});
       return {
-        // A persistent context has no browser object to ask (context.browser() is null).
-        version: 'Chromium',
         firstPage: async () => context.pages()[0] || context.newPage(),
         newPage: () => context.newPage(),
         // Runs fn in every page and frame opened from now on, before their own scripts.
@@ -102,13 +100,14 @@ function shown(selector) {
          getComputedStyle(element).visibility !== 'hidden';
 }
 
-// A process that outlives this one for as long as it lives: when this process is gone, killed without any chance
-// to clean up (SIGKILL from a ctest timeout, say), it kills Firefox's process group and removes its profile.
-// Chromium needs none: playwright talks to it through a pipe, and it exits when the pipe closes. Firefox is
-// talked to over a WebSocket and would stay. Returns a function that stops the guard (clean ends need it not).
+// A small shell process that waits for this one to end: if it ends without cleaning up (SIGKILL from a ctest
+// timeout, say), the guard kills Firefox's process group and removes its profile. Chromium needs none: playwright
+// talks to it through a pipe, and it exits when the pipe closes; Firefox is talked to over a WebSocket and would
+// stay. Returns a function that stops the guard, for the ends that clean up themselves.
 function startOrphanGuard(firefoxPid, profileDir) {
   // dash's kill takes no -- after -KILL, only after -s KILL.
-  const script = 'while kill -0 "$1" 2>/dev/null; do sleep 1; done; kill -s KILL -- "-$2" 2>/dev/null; rm -rf -- "$3"';
+  const script = 'while kill -0 "$1" 2>/dev/null; do sleep 1; done; ' +
+                 'kill -s KILL -- "-$2" 2>/dev/null; rm -rf -- "$3"';
   const guard = spawn('/bin/sh', ['-c', script, 'rfbsim-e2e-firefox-guard', String(process.pid), String(firefoxPid),
                                   profileDir], { detached: true, stdio: 'ignore' });
   guard.unref();
@@ -159,8 +158,7 @@ function firefoxDriver(webDir) {
         handleSIGHUP: false,
       });
       stopGuard = startOrphanGuard(browser.process().pid, profileDir);
-      const version = await browser.version();
-      log(`launched ${version}`);
+      log(`launched ${await browser.version()}`);
 
       // Playwright's context has init scripts and credentials for all its pages; puppeteer has them per page.
       const initScripts = [];
@@ -180,7 +178,6 @@ function firefoxDriver(webDir) {
         return page;
       };
       return {
-        version,
         // Not the tab Firefox opens at start: headless, that one never gets the window's focus
         // (document.hasFocus() stays false however it is clicked, so the page rightly keeps its "click here"
         // hint and the test could not tell whether keys reach it), while a tab opened over BiDi does, as a
@@ -213,7 +210,8 @@ function firefoxDriver(webDir) {
     isHidden: async (target, selector) => !await target.evaluate(shown, selector),
     isEnabled: (target, selector) => target.$eval(selector, (element) => !element.disabled),
     innerText: (target, selector) => target.$eval(selector, (element) => element.innerText),
-    attribute: (target, selector, name) => target.$eval(selector, (element, name) => element.getAttribute(name), name),
+    attribute: (target, selector, name) => target.$eval(selector, (element, attr) => element.getAttribute(attr),
+                                                        name),
     count: (target, selector) => target.evaluate((selector) => document.querySelectorAll(selector).length, selector),
 
     // WebDriver BiDi has no WebSocket events; Firefox does report each WebSocket's handshake as a request
