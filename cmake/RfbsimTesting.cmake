@@ -20,8 +20,8 @@
 #
 #   rfbsim_test_load(<test>... CPU <percent> [COST <seconds>] [BROWSER])
 #     The same accounting for tests added with add_test: CPU as above, COST its usual seconds, BROWSER for a
-#     test that drives Chromium: at most RFBSIM_BROWSERS_AT_ONCE of them run at once, and they start before
-#     every other test (COST + 200), since two lanes of them are the run's longest chain.
+#     test that drives a browser (Chromium or Firefox): at most RFBSIM_BROWSERS_AT_ONCE of them run at once, and
+#     they start before every other test (COST + 200), since two lanes of them are the run's longest chain.
 #
 # With RFBSIM_NO_SKIP=1 in the environment (scripts/test.sh and CI set it: they install everything the tests
 # need) every skip fails instead, naming what is missing.

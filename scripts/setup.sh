@@ -34,8 +34,8 @@ command -v npm >/dev/null 2>&1 || packages+=(npm)
 # HAProxy for the cluster tests (scripts/run-cluster-demo.sh; a study installs it on its balancer host),
 # MuJoCo for examples/mujoco_rfb, and TigerVNC's Xvnc with a few X11 programs (glxgears, xeyes, Xlib for our
 # key-echo program) for session_kind x11 (docs/other-simulators.md; a study installs what its own kind needs).
-# Clients we did not write: Firefox ESR (driven over WebDriver BiDi), TigerVNC's viewer under Xvfb with xdotool
-# for keys, and Debian's stock noVNC 1.3 page (bench_network's JPEG-only browser row).
+# Clients we did not write: Firefox ESR (the Firefox browser tests, driven over WebDriver BiDi), TigerVNC's viewer
+# under Xvfb with xdotool for keys, and Debian's stock noVNC 1.3 page (bench_network's JPEG-only browser row).
 [ "$with_browser" = 1 ] && packages+=(chromium clang libclang-rt-14-dev haproxy
   libmujoco-dev tigervnc-standalone-server mesa-utils x11-apps x11-utils libx11-dev
   firefox-esr tigervnc-viewer xvfb xdotool novnc)
@@ -52,7 +52,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# The page's npm packages, exactly as locked (noVNC; playwright-core drives Debian's Chromium in tests).
+# The page's npm packages, exactly as locked (noVNC; playwright-core drives Debian's Chromium in tests,
+# puppeteer-core Debian's Firefox ESR).
 if [ ! -f web/node_modules/.package-lock.json ] || ! cmp -s web/package-lock.json web/.installed-lock.json; then
   echo "setup: npm ci in web/"
   npm ci --prefix web --no-audit --no-fund --loglevel=error

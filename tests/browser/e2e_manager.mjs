@@ -1,26 +1,31 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Browser end-to-end test of sim_manager: a real Chromium follows participant links, sees the start-up progress
-// and the first picture, walks, reloads, is embedded in a survey (allowed and refused origins), is ended by the
-// researcher through the admin API, and the admin page lists sessions, watches one view-only and ends it.
+// Browser end-to-end test of sim_manager: a real browser (Chromium, or Firefox ESR with --browser firefox) follows
+// participant links, sees the start-up progress and the first picture, walks, reloads, is embedded in a survey
+// (allowed and refused origins), is ended by the researcher through the admin API, and the admin page lists
+// sessions, watches one view-only and ends it. The stream the walking page got (codec, frame rate) is logged.
 //
-// Usage: node e2e_manager.mjs SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
+// Usage: node e2e_manager.mjs [--browser chromium|firefox] SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
 //   SIM_MANAGER    the sim_manager executable to start
 //   SIM_RFB        the sim_rfb executable it starts per session (through a small wrapper script that can delay
 //                  the start, so that the page's start-up progress can be seen)
 //   WEB_ROOT       the assembled web root (build/web/root) sim_manager serves
-//   ARTIFACTS_DIR  where screenshots (manager_*.png), sim_manager's output, its data folder (manager-data) and
-//                  the browser console are written (created)
-//   WEB_DIR        the source web/ folder whose node_modules holds playwright-core (default: ../../web from here)
-// Environment: RFBSIM_CHROMIUM (default /usr/bin/chromium), RFBSIM_E2E_TIMEOUT_S (default 150).
+//   ARTIFACTS_DIR  where screenshots (manager_*.png; firefox_manager_*.png in Firefox), sim_manager's output, its
+//                  data folder (manager-data; firefox-manager-data) and the browser console are written (created)
+//   WEB_DIR        the source web/ folder whose node_modules holds playwright-core and puppeteer-core (default:
+//                  ../../web from here)
+// Environment: RFBSIM_CHROMIUM (default /usr/bin/chromium), RFBSIM_FIREFOX (default /usr/bin/firefox-esr),
+// RFBSIM_E2E_TIMEOUT_S (default 150).
 // Exits 0 when every check passed, 1 on the first failed check, 2 on the overall timeout.
 
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 
+import { loadDriver } from './browser_driver.mjs';
+import { logAutoCodecStream } from './stream_probe.mjs';
 import {
-  PIXEL_CHANGE_THRESHOLD, changedFraction, check, childrenOf, launchBrowser, log, onCleanup, openPage, pageState,
-  parseManagerArgs, poll, prepare, procInfo, recordPage, runTest, serveHtmlPage, sleep, snapshot, startSim,
+  PIXEL_CHANGE_THRESHOLD, changedFraction, check, childrenOf, log, onCleanup, openPage, pageState,
+  parseManagerArgs, poll, procInfo, recordPage, runTest, serveHtmlPage, sleep, snapshot, startSim,
   stopSimCleanly, waitForConnection, waitForPicture,
 } from './e2e_support.mjs';
 
@@ -41,6 +46,10 @@ const TOKEN_PATH = /^\/s\/([0-9a-f]{32})\/$/;
 
 
 const env = parseManagerArgs('e2e_manager.mjs');
+// The Chromium test's files keep their names; the Firefox run's beside them get a firefox_ (firefox-) prefix.
+const PREFIX = env.browser === 'chromium' ? '' : `${env.browser}_`;
+const artifact = (name) => path.join(env.artifacts, `${PREFIX}${name}`);
+const artifactDir = (name) => path.join(env.artifacts, `${PREFIX.replace('_', '-')}${name}`);
 
 // ---------------------------------------------------------------------------------------------------------------
 // Helpers: the manager's HTTP API, the session processes, the survey servers.
@@ -61,6 +70,18 @@ async function listSessions() {
   const response = await request('api/sessions', { admin: true });
   check(response.status === 200, `GET /api/sessions with the token answered HTTP ${response.status}`);
   return response.json();
+}
+
+// Logs the stream sim_rfb last reported for uid's live session (GET /api/sessions: codec, frame rate, round trip),
+// so that each run says what its browser was sent. sim_rfb reports about once a second while someone watches.
+async function logStream(uid, when) {
+  const session = await poll(`the stream report of ${uid}`, 5000, 250, async () => {
+    const live = (await listSessions()).live.find((s) => s.uid === uid);
+    return live && live.codec ? live : null;
+  }).catch(() => null);
+  log(`stream of ${uid} ${when} (${env.browser}): ` + (session
+    ? `codec ${session.codec}, ${session.fps} updates/s, round trip ${session.rtt_ms} ms`
+    : 'not reported within 5 s'));
 }
 
 const startLink = (uid) => new URL(`start?uid=${encodeURIComponent(uid)}&scenario=${SCENARIO}`, base).href;
@@ -136,7 +157,7 @@ function waitForFirstFrame(target, what) {
 // The test.
 // ---------------------------------------------------------------------------------------------------------------
 async function main() {
-  const chromium = prepare(env);
+  const driver = loadDriver(env);
   check(fs.existsSync(env.simRfbPath), `sim_rfb not found at ${env.simRfbPath}`);
   check(fs.existsSync(path.join(env.webRoot, 'admin.html')), `no admin.html in the web root ${env.webRoot}`);
 
@@ -153,14 +174,14 @@ async function main() {
     `exec '${env.simRfbPath}' "$@"`,
     '',
   ].join('\n'), { mode: 0o755 });
-  const dataDir = path.join(env.artifacts, 'manager-data');
+  const dataDir = artifactDir('manager-data');
   fs.rmSync(dataDir, { recursive: true, force: true });
 
   const survey = await startSurveyServer('survey server (allowed origin)');
   const stranger = await startSurveyServer('survey server (origin not allowed)');
 
   // 1. sim_manager starts; its session processes are watched so that none can outlive the test.
-  const manager = await startSim(env, 'sim_manager', [
+  const manager = await startSim(env, `${PREFIX}sim_manager`, [
     '--port', '0', '--data-dir', dataDir, '--scenarios', SCENARIO, '--admin-token', ADMIN_TOKEN,
     '--frame-origins', survey.origin, '--idle-timeout-s', String(IDLE_TIMEOUT_S),
     '--session-command', wrapper, '--web-root', env.webRoot,
@@ -191,18 +212,14 @@ async function main() {
   check(unauthorised.status === 401, `GET /api/sessions without the token answered HTTP ${unauthorised.status}`);
 
   // 2. The browser (admin credentials only for sim_manager's origin, only when asked for them).
-  const context = await launchBrowser(chromium, VIEWPORT, {
-    httpCredentials: { username: 'researcher', password: ADMIN_TOKEN, origin: new URL(base).origin },
+  const browser = await driver.launch(VIEWPORT, {
+    credentials: { username: 'researcher', password: ADMIN_TOKEN, origin: new URL(base).origin },
   });
-  await context.addInitScript(recordStatusLine);
-  const page = context.pages()[0] || await context.newPage();
-  const pageLog = recordPage(page, path.join(env.artifacts, 'manager-browser-console.log'));
-  const sockets = [];
-  page.on('websocket', (ws) => {
-    const entry = { url: ws.url(), openedAt: Date.now(), firstDataAt: null };
-    sockets.push(entry);
-    ws.once('framereceived', () => { entry.firstDataAt = Date.now(); });
-  });
+  await browser.addInitScript(recordStatusLine);
+  const page = await browser.firstPage();
+  const pageLog = recordPage(page, artifact('manager-browser-console.log'));
+  log(`browser: ${await page.evaluate(() => navigator.userAgent)}`);
+  const sockets = driver.watchWebSockets(page);
 
   // ---- a. The link leads to /s/<token>/, which shows progress, then a picture. ----
   const link1 = startLink('e2e-1');
@@ -223,7 +240,8 @@ async function main() {
   log(`  page time: redirect done ${ms(timing.redirectEnd)}, page loaded ${ms(timing.responseEnd)}, ` +
       `DOMContentLoaded (noVNC's modules in) ${ms(timing.domContentLoaded)}; wall time from goto: WebSocket ` +
       `opened ${ms(socket1 && socket1.openedAt - navigatedAt)}, first RFB bytes ` +
-      `${ms(socket1 && socket1.firstDataAt && socket1.firstDataAt - navigatedAt)}`);
+      `${ms(socket1 && socket1.firstDataAt && socket1.firstDataAt - navigatedAt)}` +
+      (driver.name === 'firefox' ? ' (WebDriver BiDi does not show WebSocket data)' : ''));
   check(socket1 && new URL(socket1.url).pathname === `/s/${token1}/ws`,
         `the page's WebSocket went to ${socket1?.url}, expected /s/${token1}/ws`);
   const seen1 = await statusSeen(page);
@@ -238,13 +256,13 @@ async function main() {
   const state1 = await pageState(page);
   check(state1.sessionState === 'running', `rfbsimState.sessionState is ${state1.sessionState}, expected running`);
   watchChildren();
-  await page.screenshot({ path: path.join(env.artifacts, 'manager_session.png') });
+  await page.screenshot({ path: artifact('manager_session.png') });
 
   // ---- b. Holding W walks: the picture changes. ----
   await sleep(500);   // the rest of the first frames
   await snapshot(page, 'A');
-  await page.locator('#screen canvas').click();
-  await page.locator('#hint').waitFor({ state: 'hidden', timeout: 5000 });
+  await driver.click(page, '#screen canvas');
+  await driver.waitHidden(page, '#hint', 5000);
   log(`holding W for ${HOLD_W_MS} ms`);
   await page.keyboard.down('w');
   await sleep(HOLD_W_MS);
@@ -256,6 +274,7 @@ async function main() {
   const walked = await changedFraction(page, 'A', 'B', PIXEL_CHANGE_THRESHOLD);
   log(`canvas pixels changed after the walk: ${(100 * walked).toFixed(1)} % (need >= ` +
       `${(100 * MIN_CHANGED_FRACTION).toFixed(1)} %)`);
+  await logStream('e2e-1', 'after the walk');
 
   // ---- c. A reload comes back to the same session; the same link does too. ----
   await page.reload({ waitUntil: 'load', timeout: 20_000 });
@@ -278,8 +297,8 @@ async function main() {
 
   // ---- d. A survey on an allowed origin embeds a session; one on another origin cannot. ----
   fs.writeFileSync(slowFlag, '');   // this session starts SLOW_START_S late: the progress must show
-  const surveyPageTab = await context.newPage();
-  const surveyLog = recordPage(surveyPageTab, path.join(env.artifacts, 'manager-survey-console.log'));
+  const surveyPageTab = await browser.newPage();
+  const surveyLog = recordPage(surveyPageTab, artifact('manager-survey-console.log'));
   await surveyPageTab.goto(`${survey.origin}/survey?uid=e2e-2`, { waitUntil: 'load', timeout: 20_000 });
   const frame = await poll('the survey iframe to reach the session page', 10_000, 100, () => {
     const child = surveyPageTab.frames().find((f) => f !== surveyPageTab.mainFrame());
@@ -301,23 +320,16 @@ async function main() {
   check(surveyFocus === 'answer', `the session page took the focus from the survey (survey focus: ${surveyFocus})`);
   log('the survey\'s field kept the keyboard focus');
   watchChildren();
-  await surveyPageTab.screenshot({ path: path.join(env.artifacts, 'manager_iframe.png') });
+  await surveyPageTab.screenshot({ path: artifact('manager_iframe.png') });
 
-  const strangerTab = await context.newPage();
-  const strangerLog = recordPage(strangerTab, path.join(env.artifacts, 'manager-stranger-console.log'));
-  const refusals = [];
-  strangerTab.on('console', (msg) => {
-    if (/frame-ancestors/.test(msg.text())) {
-      refusals.push(msg.text());
-    }
-  });
-  let strangerSockets = 0;
-  strangerTab.on('websocket', () => { strangerSockets += 1; });
+  const strangerTab = await browser.newPage();
+  const strangerLog = recordPage(strangerTab, artifact('manager-stranger-console.log'));
+  const strangerSockets = driver.watchWebSockets(strangerTab);
   await strangerTab.goto(`${stranger.origin}/survey?uid=e2e-2`, { waitUntil: 'load', timeout: 20_000 });
   const blocked = await poll('the browser to refuse the frame on the other origin', BLOCKED_FRAME_TIMEOUT_MS, 100,
                              () => {
     const child = strangerTab.frames().find((f) => f !== strangerTab.mainFrame());
-    return child && child.url().startsWith('chrome-error:') ? child : null;
+    return child && driver.isRefusedFrame(child) ? child : null;
   });
   await sleep(500);
   let blockedState = 'absent';
@@ -327,10 +339,11 @@ async function main() {
     blockedState = `not readable (${err.message.split('\n')[0]})`;
   }
   check(blockedState !== 'object', 'the session page runs inside a frame on an origin that is not allowed');
-  check(strangerSockets === 0, 'the refused frame opened a WebSocket');
+  check(strangerSockets.length === 0, 'the refused frame opened a WebSocket');
+  const refusals = strangerLog.cspReports.filter((text) => /frame-ancestors/.test(text));
   log(`frame on ${stranger.origin} refused: url ${blocked.url()}, rfbsimState ${blockedState}, ` +
       `console: ${refusals[0] ? refusals[0].slice(0, 160) : '(no CSP message)'}`);
-  await strangerTab.screenshot({ path: path.join(env.artifacts, 'manager_iframe_refused.png') });
+  await strangerTab.screenshot({ path: artifact('manager_iframe_refused.png') });
   const liveAfterFrames = (await listSessions()).live;
   check(liveAfterFrames.length === 2,
         `expected 2 live sessions (e2e-1, e2e-2): ${JSON.stringify(liveAfterFrames)}`);
@@ -342,55 +355,56 @@ async function main() {
   const ended = await request(`api/sessions/${id1}/end`, { method: 'POST', admin: true,
                                                           headers: { 'X-Rfbsim-Admin': '1' } });
   check(ended.status === 200, `POST /api/sessions/${id1}/end answered HTTP ${ended.status}`);
-  const panel = page.locator('#disconnected');
-  await panel.waitFor({ state: 'visible', timeout: 10_000 });
-  const panelTitle = (await page.locator('#disconnected-title').innerText()).trim();
-  const panelText = (await panel.innerText()).replace(/\s+/g, ' ').trim();
+  await driver.waitVisible(page, '#disconnected', 10_000);
+  const panelTitle = (await driver.innerText(page, '#disconnected-title')).trim();
+  const panelText = (await driver.innerText(page, '#disconnected')).replace(/\s+/g, ' ').trim();
   const endedState = await pageState(page);
   const { code: endCode, reason: endReason } = endedState.lastDisconnect;
   log(`ended page: "${panelText}" (close ${endCode} "${endReason}", session state ${endedState.sessionState})`);
   check(panelTitle === 'Session ended', `the panel's title is "${panelTitle}", expected "Session ended"`);
   check(/researcher/i.test(panelText), 'the panel does not say that the researcher ended the session');
-  check(await page.locator('#reconnect').isHidden(), 'a Reconnect button shows for a session that is over');
+  check(await driver.isHidden(page, '#reconnect'), 'a Reconnect button shows for a session that is over');
   check(endedState.lastDisconnect.final === true && endedState.lastDisconnect.code === 1001 &&
         endedState.lastDisconnect.reason === 'session ended by the researcher',
         `rfbsimState.lastDisconnect: ${JSON.stringify(endedState.lastDisconnect)}`);
-  await page.screenshot({ path: path.join(env.artifacts, 'manager_ended.png') });
+  await page.screenshot({ path: artifact('manager_ended.png') });
   const gone = await request(`s/${token1}/`);
   check(gone.status === 410, `the ended session's page answered HTTP ${gone.status}, expected 410`);
 
   // ---- f. The admin page (HTTP Basic) lists e2e-2 live and e2e-1 ended, and ends e2e-2. ----
-  const adminTab = await context.newPage();
-  const adminLog = recordPage(adminTab, path.join(env.artifacts, 'manager-admin-console.log'));
+  const adminTab = await browser.newPage();
+  const adminLog = recordPage(adminTab, artifact('manager-admin-console.log'));
   const adminResponse = await adminTab.goto(new URL('admin', base).href, { waitUntil: 'load', timeout: 20_000 });
   check(adminResponse && adminResponse.status() === 200, `GET /admin answered HTTP ${adminResponse?.status()}`);
-  const row2 = adminTab.locator('#live tbody tr', { hasText: 'e2e-2' });
-  await row2.waitFor({ state: 'visible', timeout: 10_000 });
-  const row1 = adminTab.locator('#recent tbody tr', { hasText: 'e2e-1' });
-  await row1.waitFor({ state: 'visible', timeout: 10_000 });
-  const row2Text = (await row2.innerText()).replace(/\s+/g, ' ').trim();
-  const row1Text = (await row1.innerText()).replace(/\s+/g, ' ').trim();
+  // Rows by session id (admin.js puts it in data-id); their text must then name the participant.
+  const id2 = liveAfterFrames.find((s) => s.uid === 'e2e-2').id;
+  const row2 = `#live tbody tr[data-id="${id2}"]`;
+  await driver.waitVisible(adminTab, row2, 10_000);
+  const row1 = `#recent tbody tr[data-id="${id1}"]`;
+  await driver.waitVisible(adminTab, row1, 10_000);
+  const row2Text = (await driver.innerText(adminTab, row2)).replace(/\s+/g, ' ').trim();
+  const row1Text = (await driver.innerText(adminTab, row1)).replace(/\s+/g, ' ').trim();
   log(`admin page: live "${row2Text}"; recent "${row1Text}"`);
-  check(/\brunning\b/.test(row2Text), 'the admin page does not show e2e-2 as running');
-  check(/\bended\b/.test(row1Text), 'the admin page does not show e2e-1 as ended');
-  check(await adminTab.locator('#live tbody tr').count() === 1, 'the admin page lists more than one live session');
-  const watchLink = row2.getByRole('link', { name: /Watch/ });
-  const watchHref = await watchLink.getAttribute('href');
+  check(/\be2e-2\b/.test(row2Text) && /\brunning\b/.test(row2Text), 'the admin page does not show e2e-2 as running');
+  check(/\be2e-1\b/.test(row1Text) && /\bended\b/.test(row1Text), 'the admin page does not show e2e-1 as ended');
+  check(await driver.count(adminTab, '#live tbody tr') === 1, 'the admin page lists more than one live session');
+  const watchLink = `${row2} a[aria-label^="Watch"]`;
+  const watchHref = await driver.attribute(adminTab, watchLink, 'href');
   check(watchHref === `/admin/watch/${token2}/`,
         `the Watch link goes to ${watchHref}, expected /admin/watch/${token2}/`);
-  check((await watchLink.innerText()).trim() === 'Watch (view only)',
-        `the Watch link says "${await watchLink.innerText()}", expected "Watch (view only)"`);
-  await adminTab.screenshot({ path: path.join(env.artifacts, 'manager_admin.png'), fullPage: true });
+  const watchText = (await driver.innerText(adminTab, watchLink)).trim();
+  check(watchText === 'Watch (view only)', `the Watch link says "${watchText}", expected "Watch (view only)"`);
+  await adminTab.screenshot({ path: artifact('manager_admin.png'), fullPage: true });
 
   // The researcher watches e2e-2: the participant's page under /admin/watch/ (behind the admin credentials, which
   // the browser also sends on the WebSocket handshake), showing the picture and the session's state.
-  const watchTab = await context.newPage();
-  recordPage(watchTab, path.join(env.artifacts, 'manager-watch-console.log'));
-  const watchSockets = [];
-  watchTab.on('websocket', (ws) => watchSockets.push(ws.url()));
+  const watchTab = await browser.newPage();
+  recordPage(watchTab, artifact('manager-watch-console.log'));
+  const watchSocketEntries = driver.watchWebSockets(watchTab);
   const watchResponse = await watchTab.goto(new URL(watchHref, base).href, { waitUntil: 'load', timeout: 20_000 });
   check(watchResponse && watchResponse.status() === 200, `GET ${watchHref} answered HTTP ${watchResponse?.status()}`);
   const watchFirstFrameAt = await waitForFirstFrame(watchTab, 'the watch page of e2e-2');
+  const watchSockets = watchSocketEntries.map((entry) => entry.url);
   check(watchSockets.length === 1 && new URL(watchSockets[0]).pathname === `/admin/watch/${token2}/ws`,
         `the watch page's WebSockets went to ${JSON.stringify(watchSockets)}, expected /admin/watch/${token2}/ws`);
   await poll('the watch page to learn the session state', 5000, 100,
@@ -406,7 +420,7 @@ async function main() {
   check(/^rfbsim_relay_connections\{kind="watch"\} 1$/m.test(metricsText),
         'rfbsim_relay_connections{kind="watch"} is not 1 while the watch page is open');
   log(`watch page of e2e-2: first picture ${Math.round(watchFirstFrameAt)} ms after its navigation started`);
-  await watchTab.screenshot({ path: path.join(env.artifacts, 'manager_watch.png') });
+  await watchTab.screenshot({ path: artifact('manager_watch.png') });
   await watchTab.close();
 
   // End from the page: confirm, then e2e-2 moves to the recent table and its iframe says the session ended.
@@ -415,22 +429,22 @@ async function main() {
     confirmText = dialog.message();
     dialog.accept();
   });
-  await row2.getByRole('button', { name: /End session/ }).click();
-  await adminTab.locator('#recent tbody tr', { hasText: 'e2e-2' }).waitFor({ state: 'visible', timeout: 10_000 });
-  await adminTab.locator('#live-empty').waitFor({ state: 'visible', timeout: 5000 });
+  await driver.click(adminTab, `${row2} button[aria-label^="End session"]`);
+  await driver.waitVisible(adminTab, `#recent tbody tr[data-id="${id2}"]`, 10_000);
+  await driver.waitVisible(adminTab, '#live-empty', 5000);
   check(confirmText.includes('e2e-2'), `the End confirmation did not name the participant: "${confirmText}"`);
-  await frame.locator('#disconnected').waitFor({ state: 'visible', timeout: 10_000 });
-  check(await frame.locator('#reconnect').isHidden(), 'the iframe offers Reconnect after the researcher ended it');
+  await driver.waitVisible(frame, '#disconnected', 10_000);
+  check(await driver.isHidden(frame, '#reconnect'), 'the iframe offers Reconnect after the researcher ended it');
   log(`ended e2e-2 from the admin page (confirm: "${confirmText}"); its iframe says "` +
-      `${(await frame.locator('#disconnected').innerText()).replace(/\s+/g, ' ').trim()}"`);
+      `${(await driver.innerText(frame, '#disconnected')).replace(/\s+/g, ' ').trim()}"`);
 
   // The page explains a 401 (credentials dropped, token changed).
-  await adminTab.route('**/api/sessions', (route) => route.fulfill({ status: 401, contentType: 'text/html',
-                                                                      body: '<h1>401</h1>' }));
+  const answerAgain = await driver.answerInstead(adminTab, '/api/sessions', { status: 401, contentType: 'text/html',
+                                                                              body: '<h1>401</h1>' });
   await poll('the admin page to explain HTTP 401', 10_000, 200, async () =>
-    /Not authorised/.test(await adminTab.locator('#message').innerText()));
-  log(`admin page on 401: "${(await adminTab.locator('#message').innerText()).trim()}"`);
-  await adminTab.unroute('**/api/sessions');
+    /Not authorised/.test(await driver.innerText(adminTab, '#message')));
+  log(`admin page on 401: "${(await driver.innerText(adminTab, '#message')).trim()}"`);
+  await answerAgain();
 
   // ---- Finally: SIGTERM stops sim_manager cleanly with a session still running, and no process is left. ----
   const link3 = await request(`start?uid=e2e-3&scenario=${SCENARIO}`);
@@ -452,7 +466,10 @@ async function main() {
   const left = [...sessionProcs.values()].filter(stillThere);
   check(left.length === 0, `session processes outlived sim_manager: ${left.map((p) => p.pid).join(', ')}`);
   log('sim_manager exited 0 and left no session process');
+  if (driver.name === 'firefox') {
+    await logAutoCodecStream(env, driver, browser, artifact('auto_codec.json'));
+  }
   await Promise.all([pageLog.close(), surveyLog.close(), strangerLog.close(), adminLog.close()]);
 }
 
-await runTest('browser_e2e_manager', 150, main);
+await runTest(`${env.browser === 'chromium' ? 'browser' : env.browser}_e2e_manager`, 150, main);

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Browser end-to-end test of network blips (issue 17): a real Chromium reaches sim_manager through a TCP relay
+// Browser end-to-end test of network blips (issue 17): a real browser (Chromium, or Firefox ESR with --browser
+// firefox) reaches sim_manager through a TCP relay
 // (tcp_relay.mjs) that plays the network. Mid-session the relay cuts every connection and refuses new ones for a
 // few seconds, without the session ending: the page must say that it is reconnecting, try again by itself with
 // growing waits, and get the same session's picture back with no click, the keyboard on the view again. Then the
@@ -7,18 +8,20 @@
 // the page must say so, must not reconnect by itself, and must take the session back when asked. Last, the researcher ends the session: the
 // page must show the ending and stay quiet.
 //
-// Usage: node e2e_reconnect.mjs SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
+// Usage: node e2e_reconnect.mjs [--browser chromium|firefox] SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
 //   (as e2e_manager.mjs; writes reconnect_*.png, sim_manager's output, its data folder (reconnect-data) and the
-//   browser console (reconnect-browser-console.log) to ARTIFACTS_DIR)
-// Environment: RFBSIM_CHROMIUM (default /usr/bin/chromium), RFBSIM_E2E_TIMEOUT_S (default 150).
+//   browser console (reconnect-browser-console.log) to ARTIFACTS_DIR, with a firefox_ (firefox-) prefix in Firefox)
+// Environment: RFBSIM_CHROMIUM (default /usr/bin/chromium), RFBSIM_FIREFOX (default /usr/bin/firefox-esr),
+// RFBSIM_E2E_TIMEOUT_S (default 150).
 // Exits 0 when every check passed, 1 on the first failed check, 2 on the overall timeout.
 
 import fs from 'node:fs';
 import path from 'node:path';
 
+import { loadDriver } from './browser_driver.mjs';
 import {
-  PIXEL_CHANGE_THRESHOLD, changedFraction, check, launchBrowser, log, onCleanup, openPage, pageState,
-  parseManagerArgs, poll, prepare, recordPage, runTest, sleep, snapshot, startSim, stopSimCleanly,
+  PIXEL_CHANGE_THRESHOLD, changedFraction, check, log, onCleanup, openPage, pageState,
+  parseManagerArgs, poll, recordPage, runTest, sleep, snapshot, startSim, stopSimCleanly,
   waitForConnection, waitForPicture,
 } from './e2e_support.mjs';
 import { startTcpRelay } from './tcp_relay.mjs';
@@ -40,6 +43,10 @@ const VIEWPORT = { width: 1024, height: 720 };
 const NOTICE_TEXT = /^Connection lost, reconnecting\u2026 \(attempt (\d+)\)/;
 
 const env = parseManagerArgs('e2e_reconnect.mjs');
+// The Chromium test's files keep their names; the Firefox run's beside them get a firefox_ (firefox-) prefix.
+const PREFIX = env.browser === 'chromium' ? '' : `${env.browser}_`;
+const artifact = (name) => path.join(env.artifacts, `${PREFIX}${name}`);
+const artifactDir = (name) => path.join(env.artifacts, `${PREFIX.replace('_', '-')}${name}`);
 
 // ---------------------------------------------------------------------------------------------------------------
 // Helpers.
@@ -144,13 +151,13 @@ function killLeftovers(procs) {
 // The test.
 // ---------------------------------------------------------------------------------------------------------------
 async function main() {
-  const chromium = prepare(env);
+  const driver = loadDriver(env);
   check(fs.existsSync(env.simRfbPath), `sim_rfb not found at ${env.simRfbPath}`);
-  const dataDir = path.join(env.artifacts, 'reconnect-data');
+  const dataDir = artifactDir('reconnect-data');
   fs.rmSync(dataDir, { recursive: true, force: true });
 
   // 1. sim_manager, and the relay in front of it: the browser only ever talks to the relay.
-  const manager = await startSim(env, 'sim_manager-reconnect', [
+  const manager = await startSim(env, `${PREFIX}sim_manager-reconnect`, [
     '--port', '0', '--data-dir', dataDir, '--scenarios', SCENARIO, '--admin-token', ADMIN_TOKEN,
     '--idle-timeout-s', String(IDLE_TIMEOUT_S), '--session-command', env.simRfbPath, '--web-root', env.webRoot,
   ]);
@@ -161,10 +168,10 @@ async function main() {
   const base = `http://127.0.0.1:${relay.port}/`;
   log(`relay on ${base} -> ${managerBase}`);
 
-  const context = await launchBrowser(chromium, VIEWPORT);
-  await context.addInitScript(recordNotices);
-  const page = context.pages()[0] || await context.newPage();
-  const pageLog = recordPage(page, path.join(env.artifacts, 'reconnect-browser-console.log'));
+  const browser = await driver.launch(VIEWPORT);
+  await browser.addInitScript(recordNotices);
+  const page = await browser.firstPage();
+  const pageLog = recordPage(page, artifact('reconnect-browser-console.log'));
 
   // 2. The link, through the relay, to a picture; the view gets the keyboard and walks.
   await openPage(page, new URL(`start?uid=${UID}&scenario=${SCENARIO}`, base).href);
@@ -177,8 +184,8 @@ async function main() {
   onCleanup(() => killLeftovers(sessionProcs));
   check(session.state === 'running', `the session is ${session.state}, expected running`);
   check(pageUrl.endsWith(`/s/${session.token}/`), `the page (${pageUrl}) is not session ${session.token}'s`);
-  await page.locator('#screen canvas').click();
-  await page.locator('#hint').waitFor({ state: 'hidden', timeout: 5000 });
+  await driver.click(page, '#screen canvas');
+  await driver.waitHidden(page, '#hint', 5000);
   check(await canvasFocused(page), 'the canvas does not have the keyboard after a click');
   const walked = await walkAndSeeChange(page, 'A', 'B');
   log(`session ${session.id} (${session.token}) shows and walks (${(100 * walked).toFixed(1)} % of pixels changed)`);
@@ -190,11 +197,11 @@ async function main() {
   relay.cutAll();
   log(`relay: connections cut, refusing new ones for ${OUTAGE_MS} ms`);
   await poll('the page to notice and start reconnecting', 5000, 50, async () => (await pageState(page)).reconnecting);
-  await page.locator('#reconnecting').waitFor({ state: 'visible', timeout: 5000 });
+  await driver.waitVisible(page, '#reconnecting', 5000);
   await sleep(OUTAGE_MS);
   const during = await pageState(page);
-  const noticeText = (await page.locator('#reconnecting-text').innerText()).trim();
-  await page.screenshot({ path: path.join(env.artifacts, 'reconnect_outage.png') });
+  const noticeText = (await driver.innerText(page, '#reconnecting-text')).trim();
+  await page.screenshot({ path: artifact('reconnect_outage.png') });
   log(`during the outage: "${noticeText}", ${during.attempts - attemptsBefore} tries, lost with close ` +
       `${during.lastLoss?.code} (${during.lastLoss?.kind})`);
   check(NOTICE_TEXT.test(noticeText), `the notice says "${noticeText}"`);
@@ -202,9 +209,9 @@ async function main() {
         `only ${during.attempts - attemptsBefore} tries in ${OUTAGE_MS} ms (expected >= ${MIN_TRIES_IN_OUTAGE})`);
   check(during.lastLoss && during.lastLoss.kind === 'lost' && during.lastLoss.code === 1006,
         `the loss is recorded as ${JSON.stringify(during.lastLoss)}, expected lost with 1006`);
-  check(!during.lastDisconnect && await page.locator('#disconnected').isHidden(),
+  check(!during.lastDisconnect && await driver.isHidden(page, '#disconnected'),
         `the disconnect panel shows during a blip: ${during.lastDisconnect?.message}`);
-  check(await page.locator('#reconnect-now').isVisible(), 'no Reconnect now button in the notice');
+  check(!await driver.isHidden(page, '#reconnect-now'), 'no Reconnect now button in the notice');
 
   // 4. The network comes back: the picture returns with no click, same session, keyboard on the view.
   relay.setRefusing(false);
@@ -215,7 +222,7 @@ async function main() {
     return state.connected && !state.reconnecting ? state : null;
   });
   await waitForPicture(page, 'C0');
-  check(await page.locator('#reconnecting').isHidden(), 'the notice still shows after reconnecting');
+  check(await driver.isHidden(page, '#reconnecting'), 'the notice still shows after reconnecting');
   check(page.url() === pageUrl, `the page moved to ${page.url()}`);
   check(back.reconnects === 1, `rfbsimState.reconnects is ${back.reconnects}, expected 1`);
   check(relay.upgrades > upgradesBefore, 'no new WebSocket went through the relay');
@@ -228,22 +235,21 @@ async function main() {
   check(!(await page.evaluate(() => window.__e2ePanelSeen)), 'the disconnect panel showed during the blip');
   log(`reconnected with no click after ${back.attempts - attemptsBefore} tries: same session ${session.id}, ` +
       `keyboard on the view, walks again (${(100 * walkedAgain).toFixed(1)} %); notices: ${notices.join(' | ')}`);
-  await page.screenshot({ path: path.join(env.artifacts, 'reconnect_back.png') });
+  await page.screenshot({ path: artifact('reconnect_back.png') });
 
   // 5. The same link opened in a second tab (straight to the manager, not through the relay): the manager hands
   // the session to the newer browser and closes this one with 4001 ("opened in another window"); the page says
   // so and does not reconnect by itself.
   const upgradesAtTakeover = relay.upgrades;
   const attemptsAtTakeover = (await pageState(page)).attempts;
-  const secondTab = await context.newPage();
+  const secondTab = await browser.newPage();
   await secondTab.goto(new URL(`s/${session.token}/`, managerBase).href);
   await waitForPicture(secondTab, 'T');
-  const panel = page.locator('#disconnected');
-  await panel.waitFor({ state: 'visible', timeout: 10_000 });
+  await driver.waitVisible(page, '#disconnected', 10_000);
   await secondTab.close();
   await sleep(QUIET_MS);
   const takenOver = await pageState(page);
-  const panelText = (await panel.innerText()).replace(/\s+/g, ' ').trim();
+  const panelText = (await driver.innerText(page, '#disconnected')).replace(/\s+/g, ' ').trim();
   log(`after 4001: "${panelText}" (${JSON.stringify({ kind: takenOver.lastDisconnect?.kind,
     code: takenOver.lastDisconnect?.code, reason: takenOver.lastDisconnect?.reason })})`);
   check(panelText.includes('This session was opened in another window or tab.'),
@@ -252,20 +258,22 @@ async function main() {
         takenOver.lastDisconnect.final === false, `lastDisconnect: ${JSON.stringify(takenOver.lastDisconnect)}`);
   check(!takenOver.reconnecting && takenOver.attempts === attemptsAtTakeover && relay.upgrades === upgradesAtTakeover,
         `the page tried again by itself after 4001 (${takenOver.attempts - attemptsAtTakeover} tries)`);
-  check(await page.locator('#reconnecting').isHidden(), 'the reconnecting notice shows after 4001');
-  await page.screenshot({ path: path.join(env.artifacts, 'reconnect_taken_over.png') });
+  check(await driver.isHidden(page, '#reconnecting'), 'the reconnecting notice shows after 4001');
+  await page.screenshot({ path: artifact('reconnect_taken_over.png') });
 
   // 6. Taking it back: one click, one try, the picture again.
-  const takeBack = page.getByRole('button', { name: 'Use it here' });
-  check(await takeBack.isVisible(), 'no "Use it here" button after 4001');
-  await takeBack.click();
+  // The panel's one button (#reconnect) says what it does.
+  const takeBackText = await driver.isHidden(page, '#reconnect')
+    ? '' : (await driver.innerText(page, '#reconnect')).trim();
+  check(takeBackText === 'Use it here', `no "Use it here" button after 4001 (the panel's button: "${takeBackText}")`);
+  await driver.click(page, '#reconnect');
   const retaken = await poll('the page to take the session back', RECOVERY_TIMEOUT_MS, 100, async () => {
     const state = await pageState(page);
     return state.connected ? state : null;
   });
   await waitForPicture(page, 'E');
   check(retaken.attempts === attemptsAtTakeover + 1, `${retaken.attempts - attemptsAtTakeover} tries to take it back`);
-  check(await panel.isHidden(), 'the panel still shows after taking the session back');
+  check(await driver.isHidden(page, '#disconnected'), 'the panel still shows after taking the session back');
   check(await canvasFocused(page), 'the view does not have the keyboard after taking the session back');
   check((await liveSession('after taking it back')).id === session.id, 'taking it back changed the session');
   log('took the session back with one click');
@@ -281,7 +289,7 @@ async function main() {
   await sleep(QUIET_MS / 2);
   const final = await pageState(page);
   check(final.attempts === attemptsAtEnd && !final.reconnecting, 'the page tried again after the session ended');
-  check(await page.locator('#reconnect').isHidden(), 'a Reconnect button shows for a session that is over');
+  check(await driver.isHidden(page, '#reconnect'), 'a Reconnect button shows for a session that is over');
   log(`ended: "${final.lastDisconnect.message}" (close ${final.lastDisconnect.code}); no further tries`);
 
   check(pageLog.pageErrors.length === 0, `uncaught errors in the page: ${pageLog.pageErrors.join(' | ')}`);
@@ -289,4 +297,4 @@ async function main() {
   await pageLog.close();
 }
 
-await runTest('browser_e2e_reconnect', 150, main);
+await runTest(`${env.browser === 'chromium' ? 'browser' : env.browser}_e2e_reconnect`, 150, main);

@@ -1,24 +1,29 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// Browser end-to-end test of streaming with the bundled noVNC in a real Chromium: ContinuousUpdates and Fence with
-// Tight JPEG, H.264 decoded by WebCodecs (compared with the JPEG picture of the same still scene), JPEG for a page
-// without WebCodecs, and the page's recovery from pictures its decoder cannot decode (web/h264_guard.js, app.js).
+// Browser end-to-end test of streaming with the bundled noVNC in a real Chromium (or Firefox ESR with --browser
+// firefox): ContinuousUpdates and Fence with Tight JPEG, H.264 decoded by WebCodecs (compared with the JPEG picture
+// of the same still scene), JPEG for a page without WebCodecs, and the page's recovery from pictures its decoder
+// cannot decode (web/h264_guard.js, app.js).
 //
-// Usage: node e2e_streaming.mjs SIM_RFB ARTIFACTS_DIR [WEB_DIR]
+// Usage: node e2e_streaming.mjs [--browser chromium|firefox] SIM_RFB ARTIFACTS_DIR [WEB_DIR]
 //   SIM_RFB        the sim_rfb executable to start (twice: --codec jpeg, then --codec h264, same seed and size)
 //   ARTIFACTS_DIR  where the canvases and screenshots (streaming_*.png), the numbers (streaming.json), the
 //                  simulators' output and the browser consoles (streaming-console*.log) are written (created)
-//   WEB_DIR        the source web/ folder whose node_modules holds playwright-core (default: ../../web from here)
-// Environment: RFBSIM_CHROMIUM (default /usr/bin/chromium), RFBSIM_E2E_TIMEOUT_S (default 90).
+//   WEB_DIR        the source web/ folder whose node_modules holds playwright-core and puppeteer-core (default:
+//                  ../../web from here)
+// Environment: RFBSIM_CHROMIUM (default /usr/bin/chromium), RFBSIM_FIREFOX (default /usr/bin/firefox-esr),
+// RFBSIM_E2E_TIMEOUT_S (default 90).
 // Exits 0 when every check passed, 1 on the first failed check, 2 on the overall timeout.
 //
-// The page is opened at http://127.0.0.1, a secure context, where Chromium has WebCodecs and noVNC offers H.264.
+// The page is opened at http://127.0.0.1, a secure context, where Chromium and Firefox have WebCodecs and noVNC
+// offers H.264.
 
 import fs from 'node:fs';
 import path from 'node:path';
 
+import { loadDriver } from './browser_driver.mjs';
 import {
-  PIXEL_CHANGE_THRESHOLD, changedFraction, check, getStatus, launchBrowser, log, openPage, pageState, parseArgs,
-  poll, prepare, recordPage, runTest, saveCanvasPng, sleep, snapshot, startSim, stopSimCleanly,
+  PIXEL_CHANGE_THRESHOLD, changedFraction, check, getStatus, log, openPage, pageState, parseArgs,
+  poll, recordPage, runTest, saveCanvasPng, sleep, snapshot, startSim, stopSimCleanly,
   waitForConnection, waitForPicture,
 } from './e2e_support.mjs';
 
@@ -46,6 +51,10 @@ const STALL_MS = 2000;                 // c: h264_guard.js's stall limit
 const BACKOFF_MS = [0, 1000, 3000];    // c: app.js's waits before the 1st, 2nd, 3rd reconnect in a row
 const RECOVERY_NOTICE = 'Restoring the picture\u2026';   // c: app.js's progress line while it takes long
 const env = parseArgs('e2e_streaming.mjs');
+let driver = null;   // browser_driver.mjs's, for env.browser (main loads it)
+// The Chromium test's files keep their names; a Firefox run's get a firefox_ prefix.
+const PREFIX = env.browser === 'chromium' ? '' : `${env.browser}_`;
+const artifact = (name) => path.join(env.artifacts, `${PREFIX}${name}`);
 
 const startStreamSim = (name, codec) => startSim(env, name, [
   '--port', '0', '--width', String(SIM_WIDTH), '--height', String(SIM_HEIGHT), '--seed', String(SEED),
@@ -212,7 +221,7 @@ async function failAndRecover(page, sim, breaker, label, shot = null) {
         reconnectMs = Date.now() - armed;
       }
       check(!state.lastDisconnect, `${label}: the page shows a disconnect: ${state.lastDisconnect?.message}`);
-      check(await page.locator('#disconnected').isHidden(), `${label}: the disconnect panel shows`);
+      check(await driver.isHidden(page, '#disconnected'), `${label}: the disconnect panel shows`);
       return reconnectMs !== null;
     });
   } finally {
@@ -234,7 +243,7 @@ async function failAndRecover(page, sim, breaker, label, shot = null) {
 async function checkLive(page, sim, label, oldStreamId) {
   const state = await pageState(page);
   check(state.focused, `${label}: the new view does not have the keyboard (a click would be needed)`);
-  check(!(await page.locator('#status').isVisible()), `${label}: the progress line still shows after recovery`);
+  check(await driver.isHidden(page, '#status'), `${label}: the progress line still shows after recovery`);
   const stream0 = await pushedStream(sim, oldStreamId);
   const changed = await pressAndSeeChange(page, 'a', 400, `${label}-live`,
                                           `${label}: the picture to change after a key press`);
@@ -248,15 +257,15 @@ async function checkLive(page, sim, label, oldStreamId) {
 // The test.
 // ---------------------------------------------------------------------------------------------------------------
 async function main() {
-  const chromium = prepare(env);
+  driver = loadDriver(env);
   const results = {};
-  const context = await launchBrowser(chromium, { width: 800, height: 600 });
-  const page = context.pages()[0] || await context.newPage();
+  const browser = await driver.launch({ width: 800, height: 600 });
+  const page = await browser.firstPage();
   const { pageErrors, close: closeConsoleLog } =
-    recordPage(page, path.join(env.artifacts, 'streaming-console.log'));
+    recordPage(page, artifact('streaming-console.log'));
 
   // ---- a. Tight JPEG with ContinuousUpdates and Fence ------------------------------------------------------
-  const jpegSim = await startStreamSim('sim_rfb-jpeg', 'jpeg');
+  const jpegSim = await startStreamSim(`${PREFIX}sim_rfb-jpeg`, 'jpeg');
   await openPage(page, jpegSim.url);
   await waitForConnection(page);
   await waitForPicture(page, 'jpeg-first');
@@ -272,10 +281,10 @@ async function main() {
   // The still scene's JPEG picture: the reference for b.
   await waitForStillPicture(page, 'jpeg-still');
   const jpegStill = await canvasPixels(page);
-  await saveCanvasPng(page, path.join(env.artifacts, 'streaming_jpeg_still_canvas.png'));
+  await saveCanvasPng(page, artifact('streaming_jpeg_still_canvas.png'));
 
   // Walking: updates keep coming without any FramebufferUpdateRequest, and the canvas keeps changing.
-  await page.locator('#screen canvas').click();
+  await driver.click(page, '#screen canvas');
   const walk0 = await pageStream(jpegSim);
   await page.keyboard.down('w');
   await page.keyboard.down('a');
@@ -309,7 +318,7 @@ async function main() {
   await stopSimCleanly(jpegSim);
 
   // ---- b. H.264 decoded by WebCodecs -----------------------------------------------------------------------
-  const h264Sim = await startStreamSim('sim_rfb-h264', 'h264');
+  const h264Sim = await startStreamSim(`${PREFIX}sim_rfb-h264`, 'h264');
   await openPage(page, h264Sim.url);
   await waitForConnection(page);
   await waitForPicture(page, 'h264-first');
@@ -321,7 +330,7 @@ async function main() {
 
   await waitForStillPicture(page, 'h264-still');
   const h264Still = await canvasPixels(page);
-  await saveCanvasPng(page, path.join(env.artifacts, 'streaming_h264_still_canvas.png'));
+  await saveCanvasPng(page, artifact('streaming_h264_still_canvas.png'));
   const codecs = compareRgba(h264Still, jpegStill);
   results.h264VsJpeg = codecs;
   log(`H.264 vs JPEG, still scene: mean |difference| R ${codecs.mad[0].toFixed(2)}, ` +
@@ -333,7 +342,7 @@ async function main() {
         `${(100 * codecs.changed).toFixed(2)} % of the H.264 picture's pixels differ from the JPEG one ` +
         `(at most ${100 * MAX_CODEC_CHANGED_FRACTION} %)`);
 
-  await page.locator('#screen canvas').click();
+  await driver.click(page, '#screen canvas');
   const turned = await pressAndSeeChange(page, 'd', 400, 'h264-turn', 'the H.264 picture to change after a turn');
   results.h264Turn = turned;
   log(`after a turn, ${(100 * turned).toFixed(1)} % of the H.264 picture changed`);
@@ -341,9 +350,9 @@ async function main() {
   // Where the browser has no VideoDecoder (any insecure context: plain http to a host other than localhost), the
   // guard stays out of the way and the same server streams JPEG: seen here on a second page whose VideoDecoder
   // is taken away before any script runs.
-  const plainPage = await context.newPage();
-  const plainLog = recordPage(plainPage, path.join(env.artifacts, 'streaming-console-no-webcodecs.log'));
-  await plainPage.addInitScript(() => { delete window.VideoDecoder; });
+  const plainPage = await browser.newPage();
+  const plainLog = recordPage(plainPage, artifact('streaming-console-no-webcodecs.log'));
+  await driver.addInitScript(plainPage, () => { delete window.VideoDecoder; });
   await openPage(plainPage, h264Sim.url);
   await waitForConnection(plainPage);
   await waitForPicture(plainPage, 'no-webcodecs');
@@ -367,7 +376,7 @@ async function main() {
   for (const [i, [breaker, reason]] of breakers.entries()) {
     const label = `failure ${i + 1}`;
     const r = await failAndRecover(page, h264Sim, breaker, label,
-                                   path.join(env.artifacts, `streaming_restoring_${i + 1}.png`));
+                                   artifact(`streaming_restoring_${i + 1}.png`));
     log(`${label}: ${r.failure.reason} reported after ${r.reportedMs} ms (${r.failure.detail}); reconnect ` +
         `after ${r.reconnectMs} ms, picture back after ${r.recoveredMs} ms` +
         (r.heldShown ? '; the frozen picture stayed on screen' : '') +
@@ -389,7 +398,7 @@ async function main() {
     recoveries.push({ ...r, ...live, h264Offered: state.h264Offered, h264Disabled: state.h264Disabled });
   }
   results.recoveries = recoveries;
-  await page.screenshot({ path: path.join(env.artifacts, 'streaming_recovered.png') });
+  await page.screenshot({ path: artifact('streaming_recovered.png') });
 
   check(recoveries[0].encoding === 'h264' && recoveries[1].encoding === 'h264',
         'after the first two failures the new connection is not on H.264 again');
@@ -401,9 +410,9 @@ async function main() {
   check(streams.length === 1, `the server has ${streams.length} streams, expected the page's one (old ones closed)`);
   check(pageErrors.length === 0, `uncaught errors in the page: ${pageErrors.join(' | ')}`);
 
-  fs.writeFileSync(path.join(env.artifacts, 'streaming.json'), `${JSON.stringify(results, null, 2)}\n`);
+  fs.writeFileSync(artifact('streaming.json'), `${JSON.stringify(results, null, 2)}\n`);
   await stopSimCleanly(h264Sim);
   await closeConsoleLog();
 }
 
-await runTest('browser_e2e_streaming', 90, main);
+await runTest(`${env.browser === 'chromium' ? 'browser' : env.browser}_e2e_streaming`, 90, main);

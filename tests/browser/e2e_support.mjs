@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Shared parts of the browser end-to-end tests (e2e_walk.mjs, e2e_scenes.mjs, e2e_robot.mjs, e2e_manager.mjs):
-// progress and failure, sim_rfb (or sim_manager) processes, a headless Chromium on the participant page, canvas
-// pixels, and cleanup whatever happens.
+// progress and failure, sim_rfb (or sim_manager) processes, a headless Chromium on the participant page (or the
+// browser of browser_driver.mjs), canvas pixels, and cleanup whatever happens.
 //
 // The sim_rfb tests take the same arguments (SIM_RFB ARTIFACTS_DIR [WEB_DIR], see parseArgs); e2e_manager.mjs
 // reads its own. Every test ends through runTest, which always stops what was started and exits 0 (passed),
@@ -127,32 +127,53 @@ export async function poll(what, timeoutMs, intervalMs, fn) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
-// Arguments: SIM_RFB ARTIFACTS_DIR [WEB_DIR]. Prints the usage and exits 1 when they are missing.
+// Arguments: [--browser chromium|firefox] SIM_RFB ARTIFACTS_DIR [WEB_DIR]. Prints the usage and exits 1 when they
+// are missing.
 // ---------------------------------------------------------------------------------------------------------------
 
-// Returns { simPath, artifacts, webDir } with absolute artifacts and webDir (default: ../../web from here).
+// The command line's arguments without `--browser NAME`, and NAME (default chromium; null if not one we drive).
+function takeBrowserOption() {
+  const args = process.argv.slice(2);
+  let browser = 'chromium';
+  const option = args.indexOf('--browser');
+  if (option !== -1) {
+    browser = args[option + 1];
+    args.splice(option, 2);
+  }
+  return { args, browser: ['chromium', 'firefox'].includes(browser) ? browser : null };
+}
+
+// Returns { browser, simPath, artifacts, webDir } with absolute artifacts and webDir (default: ../../web from
+// here). Arguments: [--browser chromium|firefox] SIM_RFB ARTIFACTS_DIR [WEB_DIR]; only the tests that run in
+// either browser (browser_driver.mjs) read `browser`.
 export function parseArgs(scriptName) {
-  const [simPath, artifactsArg, webArg] = process.argv.slice(2);
-  if (!simPath || !artifactsArg) {
-    console.error(`usage: node ${scriptName} SIM_RFB ARTIFACTS_DIR [WEB_DIR]`);
+  const { args, browser } = takeBrowserOption();
+  const [simPath, artifactsArg, webArg] = args;
+  if (!simPath || !artifactsArg || !browser) {
+    console.error(`usage: node ${scriptName} [--browser chromium|firefox] SIM_RFB ARTIFACTS_DIR [WEB_DIR]`);
     process.exit(1);
   }
   return {
+    browser,
     simPath,
     artifacts: path.resolve(artifactsArg),
     webDir: path.resolve(webArg || path.join(here, '..', '..', 'web')),
   };
 }
 
-// The arguments of the sim_manager tests: SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]. Returns
-// { simPath (sim_manager: what startSim starts), simRfbPath, webRoot, artifacts, webDir }, paths absolute.
+// The arguments of the sim_manager tests: [--browser chromium|firefox] SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR
+// [WEB_DIR]. Returns { browser, simPath (sim_manager: what startSim starts), simRfbPath, webRoot, artifacts,
+// webDir }, paths absolute. Only the tests that run in either browser (browser_driver.mjs) read `browser`.
 export function parseManagerArgs(scriptName) {
-  const [managerPath, simRfbPath, webRoot, artifactsArg, webArg] = process.argv.slice(2);
-  if (!managerPath || !simRfbPath || !webRoot || !artifactsArg) {
-    console.error(`usage: node ${scriptName} SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]`);
+  const { args, browser } = takeBrowserOption();
+  const [managerPath, simRfbPath, webRoot, artifactsArg, webArg] = args;
+  if (!managerPath || !simRfbPath || !webRoot || !artifactsArg || !browser) {
+    console.error(`usage: node ${scriptName} [--browser chromium|firefox] SIM_MANAGER SIM_RFB WEB_ROOT ` +
+                  'ARTIFACTS_DIR [WEB_DIR]');
     process.exit(1);
   }
   return {
+    browser,
     simPath: managerPath,
     simRfbPath: path.resolve(simRfbPath),
     webRoot: path.resolve(webRoot),
@@ -161,12 +182,17 @@ export function parseManagerArgs(scriptName) {
   };
 }
 
-// Checks that sim_rfb and Chromium exist, creates the artifacts folder, and returns playwright's chromium.
-export function prepare(env) {
+// Checks that the simulator (env.simPath) exists and creates the artifacts folder.
+export function prepareRun(env) {
   check(fs.existsSync(env.simPath), `sim_rfb not found at ${env.simPath}`);
-  check(fs.existsSync(CHROMIUM), `Chromium not found at ${CHROMIUM}`);
   fs.mkdirSync(env.artifacts, { recursive: true });
   log(`artifacts go to ${env.artifacts}`);
+}
+
+// Checks that sim_rfb and Chromium exist, creates the artifacts folder, and returns playwright's chromium.
+export function prepare(env) {
+  prepareRun(env);
+  check(fs.existsSync(CHROMIUM), `Chromium not found at ${CHROMIUM}`);
 
   // playwright-core lives in web/node_modules (NODE_PATH does not reach ES module imports).
   try {
@@ -292,11 +318,24 @@ export function firstStatus(sim) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
-// The browser: one persistent context in a fresh profile, closed by cleanup.
+// The browser: one per test, in a fresh profile, closed by cleanup (Chromium here; Firefox through
+// browser_driver.mjs, which hands its browser to cleanup with adoptBrowser).
 // ---------------------------------------------------------------------------------------------------------------
-let context = null;
+let browserClose = null;   // async: closes the browser politely (cleanup)
+let browserKill = null;    // sync: kills what is left of it (the exit handler), or null where its library does
 let userDataDir = null;
 const consoleLogs = [];   // every log stream recordPage opened, for cleanup
+
+// Makes a browser cleanup's to stop: close() (async) first, then its profile folder goes; kill() (sync, may be
+// null) runs when the process ends without cleanup. Once per test, like launchBrowser, which uses it.
+export function adoptBrowser({ profileDir, close, kill = null }) {
+  if (userDataDir !== null) {
+    throw new Error('a second browser in one test: a test has one browser; use the one it has');
+  }
+  userDataDir = profileDir;
+  browserClose = close;
+  browserKill = kill;
+}
 
 // Launches headless Chromium with a window of viewport { width, height } and resolves with its context.
 // contextOptions: more of playwright's launchPersistentContext options (httpCredentials, say).
@@ -305,9 +344,12 @@ export async function launchBrowser(chromium, viewport, contextOptions = {}) {
   if (userDataDir !== null) {
     throw new Error('launchBrowser called a second time: a test has one browser; use the context it returned');
   }
-  userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'rfbsim-e2e-chromium-'));
+  const profileDir = fs.mkdtempSync(path.join(os.tmpdir(), 'rfbsim-e2e-chromium-'));
+  let context = null;
+  // Playwright kills the browser it launched when the process exits, so there is nothing to kill here.
+  adoptBrowser({ profileDir, close: () => (context ? context.close() : Promise.resolve()) });
   log(`launching ${CHROMIUM}`);
-  context = await chromium.launchPersistentContext(userDataDir, {
+  context = await chromium.launchPersistentContext(profileDir, {
     ...contextOptions,
     executablePath: CHROMIUM,
     headless: true,
@@ -321,17 +363,42 @@ export async function launchBrowser(chromium, viewport, contextOptions = {}) {
   return context;
 }
 
+// What Firefox says, as a script error of the page, when a WebSocket cannot connect or is cut while it loads.
+const FIREFOX_SOCKET_REPORT = new RegExp('^(Firefox can[\u2019\']t establish a connection to the server at wss?:' +
+                                         '|The connection to wss?:\\S+ was interrupted while the page was loading)');
+
 // Writes the page's console, uncaught errors, failed requests and HTTP errors to logPath. Returns
-// { pageErrors, badResponses, close() }: the two lists fill as the page runs; close() resolves once the log is
-// written out. Cleanup closes it too, if the test did not get that far.
+// { pageErrors, badResponses, cspReports, close() }: the lists fill as the page runs (cspReports: the browser's
+// Content-Security-Policy refusals); close() resolves once the log is written out. Cleanup closes it too, if the
+// test did not get that far. Works on a playwright and on a puppeteer page alike.
 export function recordPage(page, logPath) {
   const consoleLog = fs.createWriteStream(logPath);
   consoleLogs.push(consoleLog);
   const write = (line) => writeLog(consoleLog, `${line}\n`);
   const pageErrors = [];
   const badResponses = [];
-  page.on('console', (msg) => write(`${msg.type()}: ${msg.text()}`));
+  const cspReports = [];
+  page.on('console', (msg) => {
+    write(`${msg.type()}: ${msg.text()}`);
+    if (/Content[- ]Security[- ]Policy/i.test(msg.text())) {
+      cspReports.push(msg.text());
+    }
+  });
   page.on('pageerror', (err) => {
+    // Firefox reports a Content-Security-Policy refusal (a frame-ancestors one, say) as a script error of the page
+    // that was refused, where Chromium logs it on the console: either way it is the browser refusing, which the
+    // tests expect, not the page failing.
+    if (/^Content-Security-Policy:/.test(err.message)) {
+      cspReports.push(err.message);
+      write(`error (CSP): ${err.message}`);
+      return;
+    }
+    // The same for a WebSocket that could not connect or was cut (Chromium: "WebSocket connection to ... failed"
+    // on the console): the page sees it as the socket's error and close events, which it handles.
+    if (FIREFOX_SOCKET_REPORT.test(err.message)) {
+      write(`error (network): ${err.message}`);
+      return;
+    }
     pageErrors.push(err.message);
     write(`pageerror: ${err.message}`);
   });
@@ -342,7 +409,7 @@ export function recordPage(page, logPath) {
       write(`response: HTTP ${res.status()} for ${res.url()}`);
     }
   });
-  return { pageErrors, badResponses, close: () => endStream(consoleLog) };
+  return { pageErrors, badResponses, cspReports, close: () => endStream(consoleLog) };
 }
 
 // window.rfbsimState as plain data (null before app.js set it).
@@ -478,8 +545,11 @@ function cleanup() {
     return cleanupPromise;
   }
   cleanupPromise = (async () => {
-    if (context) {
-      await Promise.race([context.close().catch(() => {}), sleep(10_000)]);
+    if (browserClose) {
+      await Promise.race([browserClose().catch(() => {}), sleep(10_000)]);
+    }
+    if (browserKill) {
+      browserKill();   // whatever a close that failed or took too long left behind
     }
     const logsWritten = consoleLogs.map(endStream);
     for (const sim of sims) {
@@ -518,6 +588,9 @@ process.on('exit', () => {
     if (!sim.exited) {
       sim.child.kill('SIGKILL');
     }
+  }
+  if (browserKill) {
+    browserKill();
   }
   if (userDataDir) {
     fs.rmSync(userDataDir, { recursive: true, force: true });

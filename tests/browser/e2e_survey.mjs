@@ -3,26 +3,29 @@
 // participant through a tutorial (which runs out of time) and a session (whose task is done at once) in iframes
 // of sim_manager's page, and must hear exactly the simulator's postMessages: started, timeout with the t2 code,
 // then started, completed with the t1 code, ended. The same demo on an origin sim_manager does not list hears
-// nothing; the session folders record the uid, the outcome and the code.
+// nothing; the session folders record the uid, the outcome and the code. Runs in Chromium, or in Firefox ESR with
+// --browser firefox.
 //
-// Usage: node e2e_survey.mjs SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
+// Usage: node e2e_survey.mjs [--browser chromium|firefox] SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
 //   SIM_MANAGER    the sim_manager executable to start
 //   SIM_RFB        the sim_rfb executable it starts per session
 //   WEB_ROOT       the assembled web root (build/web/root) sim_manager serves
-//   ARTIFACTS_DIR  where screenshots (survey_*.png), sim_manager's output, its data folder (survey-data) and the
-//                  browser console are written (created)
-//   WEB_DIR        the source web/ folder: survey-demo.html, and node_modules with playwright-core (default:
-//                  ../../web from here)
-// Environment: RFBSIM_CHROMIUM (default /usr/bin/chromium), RFBSIM_E2E_TIMEOUT_S (default 150).
+//   ARTIFACTS_DIR  where screenshots (survey_*.png; firefox_survey_*.png in Firefox), sim_manager's output, its
+//                  data folder (survey-data; firefox-survey-data) and the browser console are written (created)
+//   WEB_DIR        the source web/ folder: survey-demo.html, and node_modules with playwright-core and
+//                  puppeteer-core (default: ../../web from here)
+// Environment: RFBSIM_CHROMIUM (default /usr/bin/chromium), RFBSIM_FIREFOX (default /usr/bin/firefox-esr),
+// RFBSIM_E2E_TIMEOUT_S (default 150).
 // Exits 0 when every check passed, 1 on the first failed check, 2 on the overall timeout.
 
 import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
+import { loadDriver } from './browser_driver.mjs';
 import {
-  check, launchBrowser, log, onCleanup, pageState, parseManagerArgs, poll, prepare, recordPage, runTest,
-  serveHtmlPage, sleep, startSim, stopSimCleanly,
+  check, log, pageState, parseManagerArgs, poll, recordPage, runTest, serveHtmlPage, sleep, startSim,
+  stopSimCleanly,
 } from './e2e_support.mjs';
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -45,6 +48,11 @@ const VIEWPORT = { width: 1100, height: 900 };
 const TOKEN_PATH = /^\/s\/[0-9a-f]{32}\/$/;
 
 const env = parseManagerArgs('e2e_survey.mjs');
+let driver = null;   // browser_driver.mjs's, for env.browser (main loads it)
+// The Chromium test's files keep their names; the Firefox run's beside them get a firefox_ (firefox-) prefix.
+const PREFIX = env.browser === 'chromium' ? '' : `${env.browser}_`;
+const artifact = (name) => path.join(env.artifacts, `${PREFIX}${name}`);
+const artifactDir = (name) => path.join(env.artifacts, `${PREFIX.replace('_', '-')}${name}`);
 
 // ---------------------------------------------------------------------------------------------------------------
 // Helpers.
@@ -96,7 +104,7 @@ function sessionFrame(page, demoPage) {
 }
 
 async function nextEnabled(page, demoPage) {
-  return page.locator(`#next-${demoPage}`).isEnabled();
+  return driver.isEnabled(page, `#next-${demoPage}`);
 }
 
 // The data folder of uid's session: DATA_DIR/sessions/<id>-<uid>.
@@ -126,12 +134,12 @@ function outcomeEvents(folder) {
 // The test.
 // ---------------------------------------------------------------------------------------------------------------
 async function main() {
-  const chromium = prepare(env);
+  driver = loadDriver(env);
   const demoFile = path.join(env.webDir, 'survey-demo.html');
   check(fs.existsSync(demoFile), `no survey-demo.html in ${env.webDir}`);
   check(fs.existsSync(env.simRfbPath), `sim_rfb not found at ${env.simRfbPath}`);
   check(fs.existsSync(QUICK_SCENARIO), `test scenario missing: ${QUICK_SCENARIO}`);
-  const dataDir = path.join(env.artifacts, 'survey-data');
+  const dataDir = artifactDir('survey-data');
   fs.rmSync(dataDir, { recursive: true, force: true });
 
   // 1. Two origins serve the demo: one that sim_manager lists in frame_origins, and one it does not.
@@ -140,7 +148,7 @@ async function main() {
 
   // 2. sim_manager with the tutorial and the quick test scenario, a short time limit for every task, and
   //    small pictures (two cores are shared with the browser).
-  const manager = await startSim(env, 'sim_manager', [
+  const manager = await startSim(env, `${PREFIX}sim_manager`, [
     '--port', '0', '--data-dir', dataDir, '--scenarios', `tutorial,quick=${QUICK_SCENARIO}`,
     '--frame-origins', surveyOrigin, '--admin-token', ADMIN_TOKEN, '--session-command', env.simRfbPath,
     '--web-root', env.webRoot,
@@ -150,11 +158,12 @@ async function main() {
   const base = manager.url;
   const managerOrigin = new URL(base).origin;
 
-  const context = await launchBrowser(chromium, VIEWPORT);
-  const page = context.pages()[0] || await context.newPage();
-  await page.addInitScript(recordAllMessages);
-  const pageLog = recordPage(page, path.join(env.artifacts, 'survey-browser-console.log'));
-  const shot = (name) => page.screenshot({ path: path.join(env.artifacts, `survey_${name}.png`) });
+  const browser = await driver.launch(VIEWPORT);
+  const page = await browser.firstPage();
+  await driver.addInitScript(page, recordAllMessages);
+  const pageLog = recordPage(page, artifact('survey-browser-console.log'));
+  log(`browser: ${await page.evaluate(() => navigator.userAgent)}`);
+  const shot = (name) => page.screenshot({ path: artifact(`survey_${name}.png`) });
 
   // ---- The intro page: the participant id from the link. ----
   const demoUrl = (origin, uid) => `${origin}/survey-demo.html?${new URLSearchParams({
@@ -167,12 +176,12 @@ async function main() {
   const intro = await demoState(page);
   check(intro && intro.page === 'intro' && intro.uid === UID && intro.manager === managerOrigin,
         `window.surveyDemo on the intro page: ${JSON.stringify(intro)}`);
-  const shownUid = (await page.locator('#uid-shown').innerText()).trim();
+  const shownUid = (await driver.innerText(page, '#uid-shown')).trim();
   check(shownUid === UID, `the demo shows the participant id "${shownUid}", expected "${UID}"`);
   await shot('intro');
 
   // ---- (b) The tutorial runs out of time: started, then timeout with the tutorial's t2 code. ----
-  await page.locator('#next-intro').click();
+  await driver.click(page, '#next-intro');
   const tutorialFrame = await sessionFrame(page, 'tutorial');
   log(`tutorial iframe at ${tutorialFrame.url()}`);
   await waitForEvent(page, 'tutorial', 'started', FIRST_PICTURE_TIMEOUT_MS);
@@ -196,12 +205,12 @@ async function main() {
         tutorialMessages[1].code === TUTORIAL_CODE_TIMEOUT && tutorialMessages.every((m) => m.uid === `${UID}-tutorial`),
         `expected started, timeout(${TUTORIAL_CODE_TIMEOUT}) for ${UID}-tutorial: ${JSON.stringify(tutorialMessages)}`);
   check(await nextEnabled(page, 'tutorial'), 'Next stays disabled after the timeout message');
-  const tutorialProgress = await page.locator('#progress-tutorial').innerText();
+  const tutorialProgress = await driver.innerText(page, '#progress-tutorial');
   check(tutorialProgress.includes(TUTORIAL_CODE_TIMEOUT), `the tutorial page does not show its code: "${tutorialProgress}"`);
   await shot('tutorial_timeout');
 
   // ---- (a) The session's task is done at once: started, completed with t1, then ended. ----
-  await page.locator('#next-tutorial').click();
+  await driver.click(page, '#next-tutorial');
   const sessionPageFrame = await sessionFrame(page, 'session');
   log(`session iframe at ${sessionPageFrame.url()}`);
   await waitForEvent(page, 'session', 'completed', FIRST_PICTURE_TIMEOUT_MS + 15_000);
@@ -221,7 +230,7 @@ async function main() {
   if (order !== 'started,completed,ended') {
     log('note: the outcome was posted before the first picture (the task was done before it was drawn)');
   }
-  const sessionProgress = await page.locator('#progress-session').innerText();
+  const sessionProgress = await driver.innerText(page, '#progress-session');
   check(sessionProgress.includes(CODE_SUCCESS), `the session page does not show its code: "${sessionProgress}"`);
   const frameState = await sessionPageFrame.evaluate(() => ({
     outcome: window.rfbsimState.outcome,
@@ -234,14 +243,14 @@ async function main() {
   await shot('session_ended');
 
   // ---- The thank-you page lists both codes. ----
-  await page.locator('#next-session').click();
+  await driver.click(page, '#next-session');
   const done = await demoState(page);
   check(done.page === 'done' &&
         JSON.stringify(done.codes) === JSON.stringify({
           tutorial: { outcome: 'timeout', code: TUTORIAL_CODE_TIMEOUT },
           session: { outcome: 'completed', code: CODE_SUCCESS },
         }), `window.surveyDemo at the end: ${JSON.stringify(done)}`);
-  const listed = await page.locator('#codes-list').innerText();
+  const listed = await driver.innerText(page, '#codes-list');
   check(listed.includes(TUTORIAL_CODE_TIMEOUT) && listed.includes(CODE_SUCCESS),
         `the thank-you page lists "${listed.replace(/\s+/g, ' ')}"`);
   await shot('done');
@@ -253,15 +262,15 @@ async function main() {
         `messages seen by the page: ${JSON.stringify(raw)}; accepted: ${JSON.stringify(done.messages)}`);
 
   // ---- (c) The same demo on an origin not in frame_origins: the browser refuses the frame; nothing arrives. ----
-  const stranger = await context.newPage();
-  await stranger.addInitScript(recordAllMessages);
-  const strangerLog = recordPage(stranger, path.join(env.artifacts, 'survey-stranger-console.log'));
+  const stranger = await browser.newPage();
+  await driver.addInitScript(stranger, recordAllMessages);
+  const strangerLog = recordPage(stranger, artifact('survey-stranger-console.log'));
   await stranger.goto(demoUrl(strangerOrigin, STRANGER_UID), { waitUntil: 'load', timeout: 20_000 });
-  await stranger.locator('#next-intro').click();
+  await driver.click(stranger, '#next-intro');
   const blocked = await poll('the browser to refuse the frame on the other origin', 15_000, 100, async () => {
     const element = await stranger.$('#frame-tutorial');
     const frame = element && await element.contentFrame();
-    return frame && frame.url().startsWith('chrome-error:') ? frame : null;
+    return frame && driver.isRefusedFrame(frame) ? frame : null;
   });
   log(`frame on ${strangerOrigin} refused (${blocked.url()}); listening ${SILENCE_MS} ms for messages`);
   await sleep(SILENCE_MS);
@@ -270,7 +279,7 @@ async function main() {
   check(strangerRaw.length === 0 && strangerDemo.messages.length === 0,
         `the survey on ${strangerOrigin} received messages: ${JSON.stringify(strangerRaw)}`);
   check(!await nextEnabled(stranger, 'tutorial'), 'Next is enabled on the refused survey');
-  await stranger.screenshot({ path: path.join(env.artifacts, 'survey_refused.png') });
+  await stranger.screenshot({ path: artifact('survey_refused.png') });
 
   // ---- (d) The session folders and the index record the uid, the outcome and the code. ----
   const expected = [
@@ -309,4 +318,4 @@ async function main() {
   await Promise.all([pageLog.close(), strangerLog.close()]);
 }
 
-await runTest('browser_e2e_survey', 150, main);
+await runTest(`${env.browser === 'chromium' ? 'browser' : env.browser}_e2e_survey`, 150, main);

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The whole study task, end to end, in Chromium: a survey page on its own origin frames a participant's link to
-// sim_manager with the shipped warehouse scenario, and a scripted participant (task_participant.mjs) does the
-// task with real key presses in the page: find the robot, follow it for the 30 s the task asks, walk to the
-// marker. It learns where everything is from the session's own data as sim_rfb writes it. Then the task's
+// The whole study task, end to end, in Chromium (or Firefox ESR with --browser firefox): a survey page on its own
+// origin frames a participant's link to sim_manager with the shipped warehouse scenario, and a scripted participant
+// (task_participant.mjs) does the task with real key presses in the page: find the robot, follow it for the 30 s
+// the task asks, walk to the marker. It learns where everything is from the session's own data as sim_rfb writes it. Then the task's
 // events must be in order (found, following, followed 30 s, marker reached, completed), the data must agree
 // with what the task monitor counted, the survey must show the success code, and the session must have ended
 // as completed in session.json, manager.json and the manager's index.
 //
-// Usage: node e2e_task.mjs SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
+// Usage: node e2e_task.mjs [--browser chromium|firefox] SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
 //   SIM_MANAGER    the sim_manager executable to start
 //   SIM_RFB        the sim_rfb executable it starts for the session
 //   WEB_ROOT       the assembled web root (build/web/root) sim_manager serves
@@ -20,7 +20,7 @@
 import fs from 'node:fs';
 import path from 'node:path';
 
-import { check, log, pageState, parseManagerArgs, runTest, stopSimCleanly } from './e2e_support.mjs';
+import { check, log, pageState, parseManagerArgs, runTest, sleep, stopSimCleanly } from './e2e_support.mjs';
 import { CODE_SUCCESS, checkEnd, readEvents, startTaskSession, taskStory } from './e2e_task_support.mjs';
 import { loadScenarioLayout } from './scenario_layout.mjs';
 import { SessionTail } from './session_tail.mjs';
@@ -83,7 +83,10 @@ async function main() {
   const run = await startTaskSession(env, {
     tag: 'task', uid: UID, sessionArgs: ['--end-grace', String(END_GRACE_S)],
   });
-  const { page, frame, folder, session } = run;
+  const { driver, page, frame, folder, session } = run;
+  // The Chromium test's files keep their names; a Firefox run's get a firefox_ prefix.
+  const prefix = env.browser === 'chromium' ? '' : `${env.browser}_`;
+  const artifact = (name) => path.join(env.artifacts, `${prefix}${name}`);
   const layout = loadScenarioLayout(session.scenario_file);
   const stepTypes = layout.scenario.task.steps.map((s) => s.type).join();
   check(stepTypes === 'find_robot,follow_robot,reach' &&
@@ -94,7 +97,7 @@ async function main() {
       `(${layout.reachTarget(2).x}, ${layout.reachTarget(2).y})`);
 
   // A click on the picture gives it the keyboard, as a participant is told to do.
-  await frame.locator('#screen canvas').click();
+  await driver.click(frame, '#screen canvas');
   check((await pageState(frame)).focused, 'the simulator view does not have the keyboard after a click');
   await run.shot('start');
 
@@ -102,7 +105,7 @@ async function main() {
   const tail = new SessionTail(folder);
   const participant = new ScriptedParticipant({ page, tail, layout, session, log });
   const startedAt = Date.now();
-  const traceFile = path.join(env.artifacts, 'task.json');
+  const traceFile = artifact('task.json');
   let summary;
   try {
     summary = await participant.run(startedAt + PARTICIPANT_DEADLINE_MS);
@@ -113,12 +116,12 @@ async function main() {
   log(`participant done in ${((Date.now() - startedAt) / 1000).toFixed(1)} s wall: ${summary.pulses.turn} turns, ` +
       `${summary.pulses.walk} walks, ${summary.pulses.back} back-offs; learnt turn rate ` +
       `${summary.turnRate.toFixed(2)} rad/s, walking speed ${summary.walkSpeed.toFixed(2)} m/s`);
-  await frame.waitForTimeout(1500);   // the code is drawn in the picture: keep it in the screenshot
+  await sleep(1500);   // the code is drawn in the picture: keep it in the screenshot
   await run.shot('completed');
 
   // The end, everywhere it is recorded.
   const ended = await checkEnd(run, UID, 'completed', CODE_SUCCESS);
-  await page.screenshot({ path: path.join(env.artifacts, 'task_ended.png') });
+  await page.screenshot({ path: artifact('task_ended.png') });
 
   // The task's events, in order.
   const events = readEvents(folder);
@@ -163,4 +166,4 @@ async function main() {
   await run.pageLog.close();
 }
 
-await runTest('browser_e2e_task', 270, main);
+await runTest(`${env.browser === 'chromium' ? 'browser' : env.browser}_e2e_task`, 270, main);

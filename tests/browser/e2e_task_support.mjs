@@ -8,9 +8,8 @@
 import fs from 'node:fs';
 import path from 'node:path';
 
-import {
-  check, launchBrowser, log, pageState, poll, prepare, recordPage, serveHtmlPage, startSim,
-} from './e2e_support.mjs';
+import { loadDriver } from './browser_driver.mjs';
+import { check, log, pageState, poll, recordPage, serveHtmlPage, startSim } from './e2e_support.mjs';
 
 export const ADMIN_TOKEN = 'e2e-task-admin-token-0123';
 export const CODE_SUCCESS = 'E2E-TASK-DONE';   // the link's t1
@@ -61,12 +60,15 @@ function surveyHtml(managerOrigin, link) {
 `;
 }
 
-/// Starts sim_manager (warehouse only, its sessions' extra arguments `sessionArgs`), the survey, Chromium on
-/// the survey page, and waits for the session's first picture in the iframe. Resolves with { manager, page,
-/// frame, pageLog, dataDir, folder (the session's data folder), session (its first session.json),
-/// shot(name) }.
-export async function startTaskSession(env, { tag, uid, sessionArgs = [] }) {
-  const chromium = prepare(env);
+let driver = null;   // browser_driver.mjs's, for env.browser (startTaskSession loads it)
+
+/// Starts sim_manager (warehouse only, its sessions' extra arguments `sessionArgs`), the survey, the browser
+/// (env.browser) on the survey page, and waits for the session's first picture in the iframe. Resolves with
+/// { manager, driver, page, frame, pageLog, dataDir, folder (the session's data folder), session (its first
+/// session.json), shot(name) }. Files are named after `tag`, with a firefox_ prefix in Firefox.
+export async function startTaskSession(env, { tag: chromiumTag, uid, sessionArgs = [] }) {
+  driver = loadDriver(env);
+  const tag = env.browser === 'chromium' ? chromiumTag : `${env.browser}_${chromiumTag}`;
   check(fs.existsSync(env.simRfbPath), `sim_rfb not found at ${env.simRfbPath}`);
   const dataDir = path.join(env.artifacts, `${tag}-data`);
   fs.rmSync(dataDir, { recursive: true, force: true });
@@ -89,8 +91,8 @@ export async function startTaskSession(env, { tag, uid, sessionArgs = [] }) {
   ]);
   managerBase = manager.url;
 
-  const context = await launchBrowser(chromium, VIEWPORT);
-  const page = context.pages()[0] || await context.newPage();
+  const browser = await driver.launch(VIEWPORT);
+  const page = await browser.firstPage();
   const pageLog = recordPage(page, path.join(env.artifacts, `${tag}-browser-console.log`));
   const shot = (name) => page.screenshot({ path: path.join(env.artifacts, `${tag}_${name}.png`) });
   const surveyUrl = `${surveyOrigin}/survey.html`;
@@ -118,7 +120,7 @@ export async function startTaskSession(env, { tag, uid, sessionArgs = [] }) {
         session.seed === String(SEED) && session.uid === uid,
         `${folder}/session.json: scenario ${session.scenario} from ${session.scenario_file}, seed ${session.seed}, ` +
         `uid ${session.uid}`);
-  return { manager, page, frame, pageLog, dataDir, folder, session, shot };
+  return { manager, driver, page, frame, pageLog, dataDir, folder, session, shot };
 }
 
 // DATA_DIR/sessions/<id>-<uid>, once it holds session.json.
@@ -135,8 +137,8 @@ function sessionFolder(dataDir, uid) {
 /// The survey page's record: { messages, outcome, code } and the code it shows.
 export async function surveyState(page) {
   const state = await page.evaluate(() => JSON.parse(JSON.stringify(window.survey)));
-  return { ...state, shownCode: (await page.locator('#code').innerText()).trim(),
-           shownOutcome: (await page.locator('#outcome').innerText()).trim() };
+  return { ...state, shownCode: (await driver.innerText(page, '#code')).trim(),
+           shownOutcome: (await driver.innerText(page, '#outcome')).trim() };
 }
 
 /// The task's story in events.jsonl, one string per timer, task, outcome and session-end event:

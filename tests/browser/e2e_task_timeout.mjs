@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// The whole study task's other ending, in Chromium: the same survey and warehouse session as e2e_task.mjs, with
-// the task's time limit cut to TIME_LIMIT_S (sim_rfb --time-limit, passed by sim_manager), and a participant who
-// does nothing. The task must time out exactly at the limit with nothing done, the survey must show the timeout
+// The whole study task's other ending, in Chromium (or Firefox ESR with --browser firefox): the same survey and
+// warehouse session as e2e_task.mjs, with the task's time limit cut to TIME_LIMIT_S (sim_rfb --time-limit, passed
+// by sim_manager), and a participant who does nothing. The task must time out exactly at the limit with nothing done, the survey must show the timeout
 // code, and the session must have ended as a timeout in session.json, manager.json and the manager's index.
 //
-// Usage: node e2e_task_timeout.mjs SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
+// Usage: node e2e_task_timeout.mjs [--browser chromium|firefox] SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
 //   (as e2e_task.mjs; writes task_timeout_*.png, task_timeout-data and its logs)
 // Environment: RFBSIM_CHROMIUM (default /usr/bin/chromium), RFBSIM_E2E_TIMEOUT_S (default 120).
 // Exits 0 when every check passed, 1 on the first failed check, 2 on the overall timeout.
@@ -54,4 +54,4 @@ async function main() {
   await run.pageLog.close();
 }
 
-await runTest('browser_e2e_task_timeout', 120, main);
+await runTest(`${env.browser === 'chromium' ? 'browser' : env.browser}_e2e_task_timeout`, 120, main);
