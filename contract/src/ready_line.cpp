@@ -33,7 +33,14 @@ ReadyLineParse ready_error(std::string error) { return {std::nullopt, std::move(
 
 }  // namespace
 
-const char* task_end_name(TaskEnd end) { return end == TaskEnd::kCompleted ? "completed" : "timeout"; }
+const char* task_end_name(TaskEnd end) {
+  switch (end) {
+    case TaskEnd::kCompleted: return "completed";
+    case TaskEnd::kTimeout: return "timeout";
+    case TaskEnd::kWatched: return "watched";
+  }
+  return "timeout";  // not reached: every value is named above
+}
 
 std::string ready_port_line(int port) { return std::string(kReadyPort) + std::to_string(port) + "\n"; }
 
@@ -72,9 +79,10 @@ ReadyLineParse parse_ready_line(std::string_view line) {
   }
   if (line_has_prefix(line, kOutcome)) {
     const std::string_view end = line.substr(kOutcome.size());
-    if (end == task_end_name(TaskEnd::kCompleted)) return ready_value(TaskOutcomeLine{TaskEnd::kCompleted});
-    if (end == task_end_name(TaskEnd::kTimeout)) return ready_value(TaskOutcomeLine{TaskEnd::kTimeout});
-    return ready_error("not 'outcome completed' or 'outcome timeout'");
+    for (const TaskEnd known : {TaskEnd::kCompleted, TaskEnd::kTimeout, TaskEnd::kWatched}) {
+      if (end == task_end_name(known)) return ready_value(TaskOutcomeLine{known});
+    }
+    return ready_error("not 'outcome completed', 'outcome timeout' or 'outcome watched'");
   }
   // "data incomplete", alone or with words after it; the reason is what follows the first "reason=".
   const std::string_view after_word = line.substr(std::min(line.size(), kDataIncomplete.size()));

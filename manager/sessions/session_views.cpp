@@ -27,7 +27,9 @@ std::string status_json(const Session& session, WallTime now, const std::vector<
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.3f", std::chrono::duration<double>(now - session.created).count());
   const auto quoted = [](const std::string& text) { return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\""; };
-  const std::string& code = session.outcome == "completed" ? session.code_success
+  // A replay's watcher (outcome "watched", sim_rfb --replay) is given the success code for now: the video
+  // condition's own codes are the manager's next step (docs/replay.md).
+  const std::string& code = session.outcome == "completed" || session.outcome == "watched" ? session.code_success
                             : session.outcome == "timeout" ? session.code_timeout
                                                            : session.outcome;  // empty without an outcome
   std::string origins;

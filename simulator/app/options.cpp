@@ -131,6 +131,13 @@ void declare_sim_options(CLI::App& app, SimOptions& o) {
                  "record the session there: session.json, trajectories.csv, events.jsonl\n"
                  "(docs/data.md); without it nothing is recorded")
       ->type_name("DIR")->check(non_empty());
+  app.add_option("--replay", o.replay,
+                 "show the session recorded in DIR (a --data-dir folder) at its own pace, view-only;\n"
+                 "it ends with outcome 'watched' (docs/replay.md)")
+      ->type_name("DIR")->check(non_empty())
+      ->excludes("--scenario")->excludes("--seed")->excludes("--crowd")->excludes("--robot-control")
+      ->excludes("--time-limit")->excludes("--avatar-start")->excludes("--avatar-goal")->excludes("--robot-start")
+      ->excludes("--robot-goal");
   app.add_option("--uid", o.uid, "participant id recorded in session.json (letters, digits, - and _)")
       ->type_name("ID")->check(satisfies(is_identifier));
   const char* code_help = "completion code shown when the task is done (--code-success) or the time is up\n"

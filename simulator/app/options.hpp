@@ -46,6 +46,8 @@ struct SimOptions {
   /// ("outcome completed\n"); closed when the program ends.
   std::optional<int> ready_fd;
   std::string data_dir;             ///< record session data here (docs/data.md); empty = nothing recorded
+  /// Play this recorded session folder to viewers instead of a live one (docs/replay.md); empty = live.
+  std::string replay;
   std::string uid;                  ///< participant id for session.json
   std::string code_success;         ///< completion code shown on success (SEAN-EP's t1); empty = none
   std::string code_timeout;         ///< completion code shown on timeout (t2); empty = none

@@ -67,4 +67,13 @@ TaskText task_text(const TaskSpec& spec, const TaskStatus& status, const std::st
   return text;
 }
 
+TaskText watched_task_text(const TaskSpec& spec, const TaskStatus& status) {
+  TaskText text = task_text(spec, status, "");
+  if (!text.corner.empty()) text.corner.erase(text.corner.begin() + 1);  // the instruction, always the second line
+  if (!text.centre.empty()) {
+    text.centre = {status.outcome == TaskOutcome::Completed ? "The task was completed." : "The time ran out."};
+  }
+  return text;
+}
+
 }  // namespace rfbsim::sim

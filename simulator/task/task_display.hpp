@@ -20,4 +20,10 @@ struct TaskText {
 /// Time left shows as m:ss, rounded up, so that "0:00" means the time is up.
 TaskText task_text(const TaskSpec& spec, const TaskStatus& status, const std::string& code);
 
+/// The words for a replay's watcher (sim_rfb --replay): the walker's HUD less what was addressed to the walker.
+/// Kept: the step count, the progress and the time left while the task runs, and what the outcome was.
+/// Dropped: the step's instruction (a watcher has nothing to do), "Thank you!" and the completion code (the
+/// walker's, not the watcher's).
+TaskText watched_task_text(const TaskSpec& spec, const TaskStatus& status);
+
 }  // namespace rfbsim::sim

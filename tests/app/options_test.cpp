@@ -121,3 +121,18 @@ TEST_CASE("the end grace option takes whole seconds from 0 to 3600 and is unset 
   CHECK(parse_sim_options({"--end-grace", "-1"}).error == "bad value '-1' for --end-grace");
   CHECK(parse_sim_options({"--end-grace", "2.5"}).error == "bad value '2.5' for --end-grace");
 }
+
+TEST_CASE("the replay option takes a session folder and refuses options that would make another world") {
+  CHECK(parse_sim_options({}).options.replay.empty());
+  const auto o = parse_sim_options({"--replay", "/data/7-p-01", "--port", "0", "--data-dir", "/data/8-w", "--uid", "w"});
+  REQUIRE(o.error.empty());
+  CHECK(o.options.replay == "/data/7-p-01");
+  CHECK(parse_sim_options({"--replay", ""}).error == "bad value '' for --replay");
+  for (const char* other : {"--scenario", "--seed", "--crowd", "--time-limit", "--avatar-start", "--robot-goal"}) {
+    const std::string value = std::string(other) == "--scenario" ? "lab" : "3";
+    const auto both = parse_sim_options({"--replay", "/data/7-p-01", other, value});
+    INFO(other << ": " << both.error);
+    CHECK(both.error.find("--replay") != std::string::npos);
+    CHECK(both.error.find(other) != std::string::npos);
+  }
+}

@@ -35,6 +35,7 @@ TEST_CASE("each writer writes the bytes the programs always wrote") {
   CHECK(contract::x11_display_line(7) == "x11 display 7\n");
   CHECK(contract::outcome_line(contract::TaskEnd::kCompleted) == "outcome completed\n");
   CHECK(contract::outcome_line(contract::TaskEnd::kTimeout) == "outcome timeout\n");
+  CHECK(contract::outcome_line(contract::TaskEnd::kWatched) == "outcome watched\n");
   CHECK(contract::data_incomplete_line("disk full") == "data incomplete reason=disk full\n");
 }
 
@@ -48,7 +49,7 @@ TEST_CASE("what each writer writes reads back as it was") {
   const auto display = read_back(contract::x11_display_line(0));
   REQUIRE(display.line);
   CHECK(std::get<contract::X11Display>(*display.line).display == 0);
-  for (const auto end : {contract::TaskEnd::kCompleted, contract::TaskEnd::kTimeout}) {
+  for (const auto end : {contract::TaskEnd::kCompleted, contract::TaskEnd::kTimeout, contract::TaskEnd::kWatched}) {
     const auto outcome = read_back(contract::outcome_line(end));
     REQUIRE(outcome.line);
     CHECK(std::get<contract::TaskOutcomeLine>(*outcome.line).end == end);
@@ -73,11 +74,20 @@ TEST_CASE("malformed lines are refused with a reason") {
   for (const std::string line :
        {"", "ready", "ready ", "ready 0", "ready 65536", "ready -1", "ready +5", "ready  5", "ready 5 ", "ready 5\r",
         "ready 5x", "ready unix", "ready unix ", "ready unix /a\tb", "x11 display ", "x11 display -1",
-        "x11 display 65536", "x11 display 1.5", "outcome", "outcome done", "outcome completed ", "data incompleted",
+        "x11 display 65536", "x11 display 1.5", "outcome", "outcome done", "outcome completed ", "outcome watched ", "outcome Watched", "outcome watch", "data incompleted",
         "stream", "stream clients=x", "hello"}) {
     const contract::ReadyLineParse parsed = contract::parse_ready_line(line);
     INFO("'" << line << "'");
     CHECK_FALSE(parsed.line.has_value());
     CHECK_FALSE(parsed.error.empty());
   }
+}
+
+TEST_CASE("a replay's watched outcome reads back, and the older outcomes keep their names") {
+  CHECK(parsed_as<contract::TaskOutcomeLine>("outcome watched").end == contract::TaskEnd::kWatched);
+  CHECK(parsed_as<contract::TaskOutcomeLine>("outcome completed").end == contract::TaskEnd::kCompleted);
+  CHECK(parsed_as<contract::TaskOutcomeLine>("outcome timeout").end == contract::TaskEnd::kTimeout);
+  CHECK(std::string(contract::task_end_name(contract::TaskEnd::kWatched)) == "watched");
+  CHECK(std::string(contract::task_end_name(contract::TaskEnd::kCompleted)) == "completed");
+  CHECK(std::string(contract::task_end_name(contract::TaskEnd::kTimeout)) == "timeout");
 }

@@ -21,6 +21,7 @@
 #include <limits>
 
 #include "lossless_rfb_client.hpp"
+#include "picture_compare.hpp"
 #include "record/session_log.hpp"
 #include "replay_fixtures.hpp"
 #include "rfb_test_client.hpp"
@@ -31,61 +32,15 @@ using namespace rfbsim;
 
 namespace {
 
-using Pixels = std::vector<std::uint8_t>;  // RGB, 3 bytes per pixel, top row first
+using test::kJpeg;
+using test::kLossless;
+using test::mean_abs_difference;
+using test::Pixels;
+using test::psnr;
+using test::rgb_of;
 
 constexpr int kWidth = 320;
 constexpr int kHeight = 240;
-
-// The tolerances, per pair of RGB pictures of the same moment (docs/replay.md, "Compared with what was
-// served"). The video is H.264 (libx264 CRF 23, 4:2:0), which softens edges and halves the colour resolution,
-// the HUD's text and the desks' outlines most. Measured at 320x240 in this lab (with the tutorial's HUD text then): the video's frame against
-// the Raw capture MAD 1.9-2.9, PSNR 33-36 dB; the worst case is a frame coded alone (a keyframe, every 2 s):
-// the capture itself through libx264 with the replay's settings loses MAD 2.7-3.6, PSNR 31-33 dB. The
-// browser's Tight JPEG (the server's quality 80, 4:2:0) adds its own loss: MAD 2.5-3.9, PSNR 32-35 dB against
-// the video. Two different moments differ by MAD 23-36, PSNR 13-16 dB. The limits sit between, with room
-// for the keyframe case on either side.
-struct Tolerance {
-  double max_mad;   ///< mean absolute difference per channel, 0..255
-  double min_psnr;  ///< dB
-};
-constexpr Tolerance kLossless{5.0, 28.0};  // Raw capture vs the video: H.264's loss alone
-constexpr Tolerance kJpeg{6.0, 27.0};      // JPEG capture vs the video: both losses
-
-// Mean absolute difference per channel, 0..255.
-double mean_abs_difference(const Pixels& a, const Pixels& b) {
-  REQUIRE(a.size() == b.size());
-  double sum = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) sum += std::abs(int{a[i]} - int{b[i]});
-  return sum / static_cast<double>(a.size());
-}
-
-// Peak signal-to-noise ratio over all channels, dB (infinite for equal pictures).
-double psnr(const Pixels& a, const Pixels& b) {
-  REQUIRE(a.size() == b.size());
-  double squares = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const double d = int{a[i]} - int{b[i]};
-    squares += d * d;
-  }
-  const double mse = squares / static_cast<double>(a.size());
-  return mse == 0.0 ? std::numeric_limits<double>::infinity() : 10.0 * std::log10(255.0 * 255.0 / mse);
-}
-
-// Whether two pictures show the same moment within `tolerance`.
-bool matches(const Pixels& a, const Pixels& b, Tolerance tolerance) {
-  return mean_abs_difference(a, b) < tolerance.max_mad && psnr(a, b) > tolerance.min_psnr;
-}
-
-// An RGBA picture as RGB.
-Pixels rgb_of(const FrameView& frame) {
-  Pixels out;
-  out.reserve(static_cast<std::size_t>(frame.width * frame.height * 3));
-  for (int y = 0; y < frame.height; ++y) {
-    const std::uint8_t* row = frame.row(y);
-    for (int x = 0; x < frame.width; ++x) out.insert(out.end(), row + x * 4, row + x * 4 + 3);
-  }
-  return out;
-}
 
 // What sim_rfb's /status.json says now: the tick and how many frames it has rendered.
 struct SimStatus {
@@ -161,36 +116,6 @@ Still capture_still(const std::string& name, int port, Viewers& viewers) {
   return {};
 }
 
-// The frames `indices` (ascending) of `video` decoded by ffmpeg into RGB, BT.709 limited range as sim_replay
-// tags them. Accurate rounding: swscale's fast path darkens every channel by about 1 (measured), a bias that
-// is the decoder's, not the replay's.
-std::vector<Pixels> decoded_frames(const std::filesystem::path& video, const std::vector<std::uint64_t>& indices,
-                                   const std::filesystem::path& raw) {
-  std::string select;
-  for (const std::uint64_t index : indices) {
-    select += (select.empty() ? "eq(n\\," : "+eq(n\\,") + std::to_string(index) + ")";
-  }
-  const test::ExitResult result = test::run_to_exit(
-      RFBSIM_FFMPEG,
-      {"-v", "error", "-y", "-i", video.string(), "-vf",
-       "select=" + select + ",scale=in_color_matrix=bt709:in_range=limited:flags=accurate_rnd+full_chroma_int",
-       "-vsync", "0", "-f", "rawvideo", "-pix_fmt", "rgb24", raw.string()},
-      std::chrono::seconds(120));
-  INFO(result.output);
-  REQUIRE(WIFEXITED(result.status));
-  REQUIRE(WEXITSTATUS(result.status) == 0);
-  std::ifstream in(raw, std::ios::binary);
-  const Pixels bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  const std::size_t size = std::size_t{kWidth} * kHeight * 3;
-  REQUIRE(bytes.size() == size * indices.size());
-  std::vector<Pixels> frames;
-  for (std::size_t i = 0; i < indices.size(); ++i) {
-    frames.emplace_back(bytes.begin() + static_cast<std::ptrdiff_t>(i * size),
-                        bytes.begin() + static_cast<std::ptrdiff_t>((i + 1) * size));
-  }
-  return frames;
-}
-
 }  // namespace
 
 TEST_CASE("the replay's video shows the frames sim_rfb served at the same ticks within H.264's loss", "[waits]") {
@@ -260,7 +185,8 @@ TEST_CASE("the replay's video shows the frames sim_rfb served at the same ticks 
   REQUIRE(still_poses.size() == 3);
   CHECK(std::hypot(still_poses[1].x - still_poses[0].x, still_poses[1].y - still_poses[0].y) > 0.5);
   CHECK(std::abs(still_poses[2].yaw - still_poses[1].yaw) > 0.3);
-  const std::vector<Pixels> frames = decoded_frames(video, indices, dir.parent_path() / "served_frames.rgb");
+  const std::vector<Pixels> frames =
+      test::decoded_frames(video, indices, kWidth, kHeight, dir.parent_path() / "served_frames.rgb");
 
   for (std::size_t i = 0; i < stills.size(); ++i) {
     const Still& still = stills[i];
@@ -282,8 +208,8 @@ TEST_CASE("the replay's video shows the frames sim_rfb served at the same ticks 
       INFO(still.name << " against the video at " << stills[j].name << ": MAD "
                       << mean_abs_difference(still.lossless, frames[j]) << ", PSNR " << psnr(still.lossless, frames[j])
                       << " dB");
-      CHECK_FALSE(matches(still.lossless, frames[j], kLossless));
-      CHECK_FALSE(matches(still.jpeg, frames[j], kJpeg));
+      CHECK_FALSE(test::matches(still.lossless, frames[j], kLossless));
+      CHECK_FALSE(test::matches(still.jpeg, frames[j], kJpeg));
     }
   }
   std::filesystem::remove_all(dir);

@@ -11,7 +11,7 @@
 
 #include "file_text.hpp"
 #include "progress_line.hpp"
-#include "provenance.hpp"
+#include "replay/provenance.hpp"
 #include "render/scene_builder.hpp"
 #include "replay_cli.hpp"
 #include "trajectory_diff.hpp"

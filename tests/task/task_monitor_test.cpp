@@ -260,3 +260,28 @@ TEST_CASE("the HUD says the step, the instruction, the progress and the time lef
   status.outcome = TaskOutcome::Completed;
   CHECK(task_text(spec, status, "").centre == std::vector<std::string>{"Task complete. Thank you!"});
 }
+
+TEST_CASE("a replay's watcher sees the step count, progress, time left and outcome, not the walker's prompts") {
+  TaskSpec spec;
+  TaskStep find;
+  find.type = TaskType::FindRobot;
+  TaskStep follow;
+  follow.type = TaskType::FollowRobot;
+  spec.steps = {find, follow};
+  TaskStatus status;
+  status.timer_running = true;
+  status.step = 1;
+  status.amount = 12.7;
+  status.goal = 30.0;
+  status.time_left = 191.2;
+  CHECK(watched_task_text(spec, status).corner ==
+        std::vector<std::string>{"Task 2 of 2", "Following: 12 / 30 s", "Time left 3:12"});
+  status.step = 0;
+  CHECK(watched_task_text(spec, status).corner == std::vector<std::string>{"Task 1 of 2", "Time left 3:12"});
+  status.outcome = TaskOutcome::Timeout;
+  CHECK(watched_task_text(spec, status).corner.empty());
+  CHECK(watched_task_text(spec, status).centre == std::vector<std::string>{"The time ran out."});
+  status.outcome = TaskOutcome::Completed;
+  CHECK(watched_task_text(spec, status).centre == std::vector<std::string>{"The task was completed."});
+  CHECK(watched_task_text(TaskSpec{}, status) == TaskText{});
+}

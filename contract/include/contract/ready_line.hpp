@@ -6,7 +6,8 @@
 //   ready unix /run/s/1.sock         the RFB unix socket listens (--unix-socket; rfbsim_x11_session)
 //   x11 display 7                    the X display the program runs on (rfbsim_x11_session, after its ready)
 //   stream clients=1 ...             the participant's stream (contract/stream_line.hpp has the keys)
-//   outcome completed                the task ended: "completed" or "timeout" (once)
+//   outcome completed                the task ended: "completed" or "timeout" (once); "watched": a replay
+//                                    (sim_rfb --replay) showed its recording to the end
 //   data incomplete reason=TEXT      the session's data can no longer be written (once; TEXT is one line)
 //
 // The writers below give the exact bytes each program writes; parse_ready_line turns a line back into a value
@@ -38,8 +39,9 @@ struct ReadyUnix {
 struct X11Display {
   int display = 0;
 };
-/// "outcome completed" or "outcome timeout": how the task ended.
-enum class TaskEnd { kCompleted, kTimeout };
+/// "outcome completed" or "outcome timeout": how the task ended; "outcome watched": the watcher of a replay
+/// (sim_rfb --replay, the study's video condition) saw the recording to its end.
+enum class TaskEnd { kCompleted, kTimeout, kWatched };
 struct TaskOutcomeLine {
   TaskEnd end = TaskEnd::kCompleted;
 };
@@ -57,7 +59,7 @@ struct ReadyLineParse {
   std::string error;  ///< empty on success
 };
 
-/// "completed" or "timeout", as the outcome line (and the manager's index) spell it.
+/// "completed", "timeout" or "watched", as the outcome line (and the manager's index) spell it.
 const char* task_end_name(TaskEnd end);
 
 /// The writers: each line's exact bytes, newline included.
@@ -69,7 +71,8 @@ std::string data_incomplete_line(const std::string& reason);
 // The stream line's writer is contract::stream_line (contract/stream_line.hpp).
 
 /// Parses one line (without its '\n') into its value; an error for a line of none of the forms above or a
-/// malformed one (a port out of range, an outcome other than completed and timeout, a bad stream pair...).
+/// malformed one (a port out of range, an outcome other than completed, timeout and watched, a bad stream
+/// pair...).
 /// A trailing '\r' is refused except on stream lines, as the manager always did. Never throws.
 ReadyLineParse parse_ready_line(std::string_view line);
 

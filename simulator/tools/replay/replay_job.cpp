@@ -17,11 +17,11 @@
 
 #include "app/frame_painter.hpp"
 #include "app/session_setup.hpp"
-#include "provenance.hpp"
+#include "replay/provenance.hpp"
+#include "replay/recording.hpp"
 #include "record/session_log.hpp"
 #include "rfbsim/offscreen_gl.hpp"
-#include "scenario/scenario.hpp"
-#include "session_replay.hpp"
+#include "replay/session_replay.hpp"
 #include "trajectory_diff.hpp"
 #include "video_writer.hpp"
 
@@ -180,16 +180,12 @@ struct Film {
 };
 
 void run_job(const ReplayOptions& options, const ProgressFn& progress, ReplayResult& result) {
-  // The log, read and checked.
-  std::error_code ec;
-  if (!std::filesystem::is_directory(options.session_dir, ec)) {
-    throw JobFailure{kExitRefused, options.session_dir.string() + ": no such folder"};
-  }
+  // The log, read and checked (replay/recording.hpp: sim_rfb --replay opens recordings alike).
   sim::SessionLog log;
   try {
-    log = sim::read_session(options.session_dir);
-  } catch (const sim::SessionLogError& e) {
-    throw JobFailure{kExitRefused, std::string("cannot read the session: ") + e.what()};
+    log = read_recording(options.session_dir);
+  } catch (const RecordingError& e) {
+    throw JobFailure{kExitRefused, e.what()};
   }
   const sim::SessionMeta& meta = log.meta;
   const std::filesystem::path session_json = options.session_dir / "session.json";
@@ -198,13 +194,9 @@ void run_job(const ReplayOptions& options, const ProgressFn& progress, ReplayRes
   check_provenance(build_mismatches(meta, sim::rfbsim_version(), sim::rfbsim_build_id()), options, session_json, result);
   sim::PreparedSession prepared;
   try {
-    prepared = sim::prepare_session(setup_of(meta));
-  } catch (const sim::ScenarioError& e) {
-    throw JobFailure{kExitRefused, "cannot rebuild the session's world from " +
-                                       (meta.scenario_file.empty() ? std::string("the built-in test room") : meta.scenario_file) +
-                                       ": " + e.what()};
-  } catch (const std::runtime_error& e) {
-    throw JobFailure{kExitRefused, std::string("cannot rebuild the session's world: ") + e.what()};
+    prepared = rebuild_world(meta);
+  } catch (const RecordingError& e) {
+    throw JobFailure{kExitRefused, e.what()};
   }
   check_provenance(file_mismatches(meta, prepared.info), options, session_json, result);
 

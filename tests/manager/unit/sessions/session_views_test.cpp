@@ -90,6 +90,17 @@ TEST_CASE("the status poll gives the outcome with the code the link carried for 
   CHECK(rfbsim::manager::status_json(s, now, {}).find(R"("outcome":"timeout","code":null)") != std::string::npos);
 }
 
+TEST_CASE("a replay's watcher (outcome watched) is given the success code, as a completed session is for now") {
+  Session s = sample();
+  s.code_success = "DONE-1";
+  s.code_timeout = "LATE-2";
+  s.outcome = "watched";
+  const auto now = s.created + std::chrono::milliseconds(1500);
+  CHECK(rfbsim::manager::status_json(s, now, {}).find(R"("outcome":"watched","code":"DONE-1")") != std::string::npos);
+  s.code_success.clear();
+  CHECK(rfbsim::manager::status_json(s, now, {}).find(R"("outcome":"watched","code":null)") != std::string::npos);
+}
+
 TEST_CASE("the admin API's session JSON names every field, and the token only when asked") {
   Session s = sample();
   s.detail = "said \"hi\"";

@@ -3,8 +3,9 @@
 // with prepare_session from session.json (scenario file, parameters, seed, tick rate, time limit), runs it
 // through a StudySession as sim_rfb did (so both take the same path through the same code), and applies
 // every input of events.jsonl at its tick, before that tick's step, in file order: keys, pointer events and
-// viewers coming and going (the first viewer starts the task clock, exactly as live). The replay records its
-// own session data, which the caller compares with the log.
+// viewers coming and going (the first viewer starts the task clock, exactly as live). sim_replay has the
+// replay record its own session data, which it compares with the log; sim_rfb --replay shows it live and
+// records none (docs/replay.md).
 #pragma once
 
 #include <cstddef>
@@ -30,8 +31,8 @@ std::uint64_t recorded_end_tick(const sim::SessionLog& log);
 class SessionReplay {
  public:
   /// Takes the world `prepared` (from setup_of(log.meta)) and records into `out_dir` (created; it must not
-  /// hold session data already). `log` must outlive this. Throws std::runtime_error when `out_dir` cannot
-  /// be written.
+  /// hold session data already), or nowhere when `out_dir` is empty. `log` must outlive this. Throws
+  /// std::runtime_error when `out_dir` cannot be written.
   SessionReplay(const sim::SessionLog& log, sim::PreparedSession prepared, const std::filesystem::path& out_dir);
   ~SessionReplay();
   SessionReplay(const SessionReplay&) = delete;
@@ -45,7 +46,7 @@ class SessionReplay {
   /// Whether the replay reached the recorded end tick.
   [[nodiscard]] bool done() const { return world().tick >= end_tick_; }
   /// Applies the inputs recorded at the end tick (after the last step), and closes the replay's session
-  /// data with the recorded end reason. Call once, when done().
+  /// data (if any) with the recorded end reason. Call once, when done().
   void finish();
 
   [[nodiscard]] std::uint64_t end_tick() const { return end_tick_; }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // SessionReplay: the recorded inputs, applied at their ticks.
-#include "session_replay.hpp"
+#include "replay/session_replay.hpp"
 
 #include <charconv>
 #include <limits>
@@ -64,7 +64,8 @@ SessionReplay::SessionReplay(const sim::SessionLog& log, sim::PreparedSession pr
   if (meta.success_code || meta.timeout_code) {
     info.codes = std::make_pair(meta.success_code.value_or(""), meta.timeout_code.value_or(""));
   }
-  writer_ = std::make_unique<sim::SessionWriter>(out_dir_, std::move(info), simulation_->world());
+  // A live replay (sim_rfb --replay) records nothing: its watcher's actions are not the recording's inputs.
+  if (!out_dir_.empty()) writer_ = std::make_unique<sim::SessionWriter>(out_dir_, std::move(info), simulation_->world());
   study_ = std::make_unique<sim::StudySession>(*simulation_, std::move(prepared.task),
                                                sim::StudyCodes{meta.success_code.value_or(""), meta.timeout_code.value_or("")},
                                                writer_.get());
@@ -129,13 +130,13 @@ void SessionReplay::apply_inputs() {
 void SessionReplay::step() {
   apply_inputs();
   study_->step();
-  writer_->flush_if_due();  // as sim_rfb does: a long replay does not hold its whole record in memory
+  if (writer_) writer_->flush_if_due();  // as sim_rfb does: a long replay does not hold its whole record in memory
 }
 
 void SessionReplay::finish() {
   apply_inputs();
   study_->finish(log_.meta.end_reason.value_or("error"));
-  writer_->flush();
+  if (writer_) writer_->flush();
 }
 
 }  // namespace rfbsim::replay

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Provenance: the log's versions against this build and the files.
-#include "provenance.hpp"
+#include "replay/provenance.hpp"
 
 namespace rfbsim::replay {
 
