@@ -3,6 +3,8 @@
 //
 // The main thread is the simulation thread: it owns the GL context, steps the world at a fixed rate,
 // and renders at the frame rate only while someone is watching. librfbsim's own thread does the network.
+// With --replay, a recorded session is shown instead (app/replay_loop.cpp), through the same serving parts
+// (app/serving.hpp).
 #include <fcntl.h>
 #include <poll.h>
 #include <unistd.h>
@@ -28,14 +30,14 @@
 #include "app/frame_schedule.hpp"
 #include "app/options.hpp"
 #include "app/parent_pipe.hpp"
+#include "app/replay_loop.hpp"
 #include "app/ros_link.hpp"
 #include "app/ros_setup.hpp"
+#include "app/serving.hpp"
 #include "app/session_setup.hpp"
 #include "app/simulation.hpp"
 #include "app/stream_status.hpp"
 #include "app/study_session.hpp"
-#include "app/watch_record.hpp"
-#include "app/watched_replay.hpp"
 #include "contract/ready_line.hpp"
 #include "record/digest.hpp"
 #include "record/session_writer.hpp"
@@ -49,6 +51,12 @@
 namespace {
 
 using rfbsim::sim::check_ready_fd;
+using rfbsim::sim::ClientChanges;
+using rfbsim::sim::report_outcome;
+using rfbsim::sim::report_ready;
+using rfbsim::sim::server_options_of;
+using rfbsim::sim::StatusBoard;
+using rfbsim::sim::StreamReporter;
 using rfbsim::sim::write_line;
 
 std::atomic<bool> g_stop{false};
@@ -67,173 +75,6 @@ void install_signal_handlers() {
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);
   sigaction(SIGPIPE, &ignore, nullptr);
-}
-
-// Tells the parent that the port is open: one line "ready <port>\n" on `fd` ("ready unix <path>\n" when
-// listening on a unix socket). The pipe stays open for the outcome line. Throws std::runtime_error when the write fails (EPIPE: the parent left).
-void report_ready(int fd, const rfbsim::Server& server) {
-  const std::string& unix_socket = server.options().unix_socket_path;
-  namespace contract = rfbsim::contract;
-  const std::string line =
-      unix_socket.empty() ? contract::ready_port_line(server.port()) : contract::ready_unix_line(unix_socket);
-  const std::string error = write_line(fd, line);
-  if (!error.empty()) {
-    ::close(fd);
-    throw std::runtime_error("--ready-fd " + std::to_string(fd) + ": cannot write the ready line (" + error + ")");
-  }
-}
-
-// The outcome line to the parent (sim_manager tells the survey); a parent that left is only logged.
-void report_outcome(int fd, rfbsim::contract::TaskEnd end) {
-  const std::string error = write_line(fd, rfbsim::contract::outcome_line(end));
-  if (!error.empty()) rfbsim::log::warn("sim_rfb", "cannot report the outcome to the parent: %s", error.c_str());
-}
-
-// The viewers' stream, told to the parent (sim_manager) on the ready pipe: a "stream ..." line about every second
-// while someone watches, and "stream clients=0" once when the last viewer leaves (app/stream_status.hpp). A
-// line is skipped rather than waited for when the pipe is full (a parent that stopped reading): the simulation
-// thread never blocks on it. A parent that is gone ends the reports, with one word in the log.
-class StreamReporter {
- public:
-  static constexpr std::chrono::seconds kInterval{1};
-
-  explicit StreamReporter(int fd) : fd_(fd) {}
-
-  void update(std::chrono::steady_clock::time_point now, int clients, const rfbsim::Server& server) {
-    if (failed_) return;
-    if (clients == 0) {
-      if (reported_) write(rfbsim::sim::stream_line({}));  // the parent stops showing the last report
-      watched_ = reported_ = false;
-      return;
-    }
-    // The first report a second after the first viewer came, once there is a frame rate to tell.
-    if (!watched_) next_ = now + kInterval;
-    watched_ = true;
-    if (now < next_) return;
-    const std::vector<rfbsim::ClientStreamStatus> streams = server.client_streams();
-    if (streams.empty()) return;  // the network thread has not seen the viewer yet: try again next loop
-    write(rfbsim::sim::stream_line(streams));
-    reported_ = true;
-    next_ = now + kInterval;
-  }
-
- private:
-  void write(const std::string& line) {
-    pollfd pfd{fd_, POLLOUT, 0};
-    if (::poll(&pfd, 1, 0) != 1 || (pfd.revents & POLLOUT) == 0) {
-      if ((pfd.revents & (POLLERR | POLLHUP)) == 0) return;  // full: this one is skipped, the next may fit
-    }
-    // Under PIPE_BUF bytes: written whole or not at all.
-    const std::string error = write_line(fd_, line);
-    if (error.empty()) return;
-    failed_ = true;
-    rfbsim::log::warn("sim_rfb", "cannot report the stream to the parent: %s; no more stream lines", error.c_str());
-  }
-
-  int fd_;
-  bool watched_ = false;   // someone watched at the last update
-  bool reported_ = false;  // a stream line was written since the last viewer came
-  bool failed_ = false;
-  std::chrono::steady_clock::time_point next_{};
-};
-
-// The page: --web-root if given, else the one built beside this binary, else the installed one.
-std::string find_web_root(const std::string& requested) {
-  if (!requested.empty()) return requested;
-  for (const char* candidate : {RFBSIM_BUILD_WEB_ROOT, RFBSIM_INSTALLED_WEB_ROOT}) {
-    std::error_code ec;
-    if (std::filesystem::is_regular_file(std::filesystem::path(candidate) / "index.html", ec)) return candidate;
-  }
-  throw std::runtime_error(std::string("no participant page found (looked in ") + RFBSIM_BUILD_WEB_ROOT + " and " +
-                           RFBSIM_INSTALLED_WEB_ROOT + "); run 'npm ci --prefix web' and rebuild, or pass --web-root");
-}
-
-// The latest status document, written by the simulation thread and read by HTTP workers.
-class StatusBoard {
- public:
-  void publish(std::string text) {
-    std::lock_guard lock(mutex_);
-    text_ = std::move(text);
-  }
-  std::string read() const {
-    std::lock_guard lock(mutex_);
-    return text_;
-  }
-
- private:
-  mutable std::mutex mutex_;
-  std::string text_ = "{}";
-};
-
-// Viewers coming and going, told by the network thread and taken by the simulation thread, so that they
-// are recorded at a tick like every other input.
-class ClientChanges {
- public:
-  struct Change {
-    bool connected = false;
-    rfbsim::ClientInfo client;
-  };
-  void push(bool connected, const rfbsim::ClientInfo& client) {
-    std::lock_guard lock(mutex_);
-    changes_.push_back({connected, client});
-  }
-  std::vector<Change> take() {
-    std::lock_guard lock(mutex_);
-    return std::exchange(changes_, {});
-  }
-
- private:
-  std::mutex mutex_;
-  std::vector<Change> changes_;
-};
-
-// The picture a session serves: its size in pixels and frames per second while watched.
-struct Picture {
-  int width = 0;
-  int height = 0;
-  int fps = 0;
-};
-
-// The server as the command line asks for it, a live session's or a replay's alike: /status.json from `status`,
-// viewers coming and going into `client_changes` (addresses logged hashed with `address_key`).
-rfbsim::ServerOptions server_options_of(const rfbsim::sim::SimOptions& options, Picture picture,
-                                        const StatusBoard& status, ClientChanges& client_changes,
-                                        const std::string& address_key) {
-  namespace sim = rfbsim::sim;
-  rfbsim::ServerOptions server_options;
-  server_options.port = options.port;
-  server_options.bind_address = options.bind;
-  server_options.width = picture.width;
-  server_options.height = picture.height;
-  server_options.jpeg_quality = options.jpeg_quality;
-  server_options.codec = options.codec == "h264"   ? rfbsim::Codec::kH264
-                         : options.codec == "jpeg" ? rfbsim::Codec::kJpeg
-                                                   : rfbsim::Codec::kAuto;
-  server_options.frame_rate = picture.fps;  // H.264 timing: the rate frames are submitted at while watched
-  server_options.max_clients = options.max_clients;
-  server_options.desktop_name = "rfbsim";
-  server_options.proxy_protocol = options.proxy_protocol;
-  server_options.allowed_origins = options.allowed_origins;
-  server_options.unix_socket_path = options.unix_socket;
-  // RFB only: no web root and no route, which librfbsim takes to mean no HTTP at all, so that a raw RFB
-  // client is served sooner (at once after sim_manager's PROXY line) than after the wait for a browser's page
-  // request.
-  if (!options.rfb_only) {
-    server_options.web_root = find_web_root(options.web_root);
-    server_options.json_routes["/status.json"] = [&status] { return status.read(); };
-  }
-  // The log names the participant's address only hashed, as the session data does.
-  server_options.on_connect = [&client_changes, &address_key](const rfbsim::ClientInfo& c) {
-    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-connected", "sim_rfb",
-                         "client %d connected, address %s (%s)", c.id,
-                         sim::hash_address(address_key, c.address).c_str(), c.websocket ? "websocket" : "rfb");
-    client_changes.push(true, c);
-  };
-  server_options.on_disconnect = [&client_changes](const rfbsim::ClientInfo& c) {
-    rfbsim::log::limited(rfbsim::log::Level::kInfo, "client-disconnected", "sim_rfb", "client %d disconnected", c.id);
-    client_changes.push(false, c);
-  };
-  return server_options;
 }
 
 // What the command line asks to build.
@@ -478,131 +319,6 @@ int run(const rfbsim::sim::SimOptions& options) {
   return 0;
 }
 
-// How long the recording's last picture stays after its end when --end-grace does not say, s: long enough to
-// see that it ended, short beside the recording itself.
-constexpr int kWatchedHoldS = 3;
-
-// sim_rfb --replay (docs/replay.md): a recorded session shown tick for tick at its own pace, view-only,
-// through the same server, painter and ready pipe as a live one. It starts with the first viewer, so that the
-// watcher sees it from its beginning; at its end the parent hears "outcome watched", and the last picture stays
-// for --end-grace seconds or until the last viewer leaves. The watcher's keys and pointer are dropped by the
-// server (view-only) and never reach the replay or any record.
-int run_replay(const rfbsim::sim::SimOptions& options) {
-  using Clock = std::chrono::steady_clock;
-  namespace sim = rfbsim::sim;
-
-  if (options.ready_fd) check_ready_fd(*options.ready_fd);
-  // The recording first: a bad one ends the program before anything listens or is written.
-  if (!options.data_dir.empty()) sim::check_watch_data_dir(options.data_dir, options.replay);
-  sim::WatchedReplay replay(options.replay);
-  const sim::SessionMeta& meta = replay.meta();
-  const Picture picture{meta.frame_width, meta.frame_height, meta.fps};  // what the walker saw
-  if (picture.width < 16 || picture.height < 16 || picture.width > 7680 || picture.height > 4320 || picture.fps < 1 ||
-      picture.fps > 240) {
-    throw rfbsim::replay::RecordingError((replay.dir() / "session.json").string() + ": a frame of " +
-                                         std::to_string(picture.width) + "x" + std::to_string(picture.height) + " at " +
-                                         std::to_string(picture.fps) + " fps cannot be shown");
-  }
-  rfbsim::log::info("sim_rfb", "replaying %s: scenario %s, uid '%s', %llu ticks at %d Hz, %dx%d at %d fps",
-                    options.replay.c_str(), meta.scenario.c_str(), meta.uid.c_str(),
-                    static_cast<unsigned long long>(replay.end_tick()), meta.tick_hz, picture.width, picture.height,
-                    picture.fps);
-  std::unique_ptr<sim::WatchRecord> record;
-  if (!options.data_dir.empty()) {
-    record = std::make_unique<sim::WatchRecord>(options.data_dir, options.uid, options.replay, meta);
-  }
-
-  const std::string address_key = sim::address_hash_key();
-  StatusBoard status;
-  ClientChanges client_changes;
-  rfbsim::ServerOptions server_options = server_options_of(options, picture, status, client_changes, address_key);
-  server_options.view_only = true;
-  rfbsim::Server server(std::move(server_options));
-
-  rfbsim::OffscreenGLOptions gl_options;
-  gl_options.width = picture.width;
-  gl_options.height = picture.height;
-  gl_options.platform = options.egl_platform;
-  rfbsim::OffscreenGL gl(gl_options);
-  rfbsim::log::info("sim_rfb", "rendering with %s", gl.renderer().c_str());
-
-  sim::FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / meta.tick_hz));
-  sim::SceneStyle scene_style;
-  scene_style.debug_overlay = options.debug_overlay;
-  sim::FramePainter painter(gl, scene_style);
-  std::uint64_t frames_rendered = 0;
-  const auto draw = [&](bool always) {
-    if (!painter.paint(replay.world(), replay.text(), always)) return;
-    server.submit(gl.read_frame());
-    ++frames_rendered;
-  };
-  const auto publish = [&](int clients) {
-    if (options.rfb_only) return;
-    status.publish(sim::with_status_member(
-        sim::status_json(replay.world(), clients, frames_rendered, sim::streams_json(server.client_streams())),
-        replay.status_member()));
-  };
-  draw(true);  // the recording's first tick, before anyone watches
-  publish(0);
-  if (options.ready_fd) report_ready(*options.ready_fd, server);
-  std::printf("sim_rfb ready: %s\n", server.url().c_str());
-  std::fflush(stdout);
-
-  std::optional<StreamReporter> stream_reporter;
-  if (options.ready_fd) stream_reporter.emplace(*options.ready_fd);
-  sim::FrameSchedule frames(std::chrono::nanoseconds(1'000'000'000LL / picture.fps));
-  const auto hold = std::chrono::seconds(options.end_grace.value_or(kWatchedHoldS));
-  bool playing = false;
-  std::optional<Clock::time_point> hold_until;  // set at the recording's end
-  std::string end_reason = "signal";
-  auto last = Clock::now();
-  while (!g_stop) {
-    const auto now = Clock::now();
-    const int ticks = clock.advance(now - last);
-    last = now;
-
-    for (const ClientChanges::Change& change : client_changes.take()) {
-      if (!change.connected) continue;
-      if (record) record->viewer_connected();
-      if (!playing) rfbsim::log::info("sim_rfb", "the first viewer came: the recording plays");
-      playing = true;
-    }
-    // The server is view-only and hands over nothing; anything that came anyway is dropped unread.
-    (void)server.poll_input();
-
-    if (playing && !replay.ended() && replay.advance(ticks)) {
-      // The last picture before the line, so that a parent (or a test) that asks after it sees the end.
-      draw(true);
-      end_reason = "watched";
-      rfbsim::log::info("task", "%.2f s outcome watched (the recording's end)", replay.world().time);
-      if (options.ready_fd) report_outcome(*options.ready_fd, rfbsim::contract::TaskEnd::kWatched);
-      hold_until = now + hold;
-      publish(server.client_count());
-    }
-    const int clients = server.client_count();
-    if (hold_until && (now >= *hold_until || clients == 0)) break;
-    if (playing && ticks > 0 && !replay.ended()) publish(clients);
-    if (stream_reporter) stream_reporter->update(now, clients, server);
-
-    if (!replay.ended() && frames.render_now(now, ticks, clients > 0)) draw(false);
-    auto wake = now + clock.until_next_step();
-    if (clients > 0) wake = std::min(wake, frames.next_frame());
-    if (hold_until) wake = std::min(wake, *hold_until);
-    std::this_thread::sleep_until(wake);
-  }
-  if (record) {
-    const std::string error = record->finish(end_reason, replay.world().tick, end_reason == "watched");
-    if (!error.empty()) rfbsim::log::warn("sim_rfb", "cannot record the end of the watching: %s", error.c_str());
-  }
-  if (options.ready_fd) ::close(*options.ready_fd);
-  rfbsim::log::flush_suppressed();
-  rfbsim::log::info("sim_rfb", "stopping the replay at tick %llu of %llu, %llu frames (%s)",
-                    static_cast<unsigned long long>(replay.world().tick),
-                    static_cast<unsigned long long>(replay.end_tick()),
-                    static_cast<unsigned long long>(frames_rendered), end_reason.c_str());
-  return 0;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -619,7 +335,7 @@ int main(int argc, char** argv) {
   rfbsim::log::set_level(parsed.options.log_level);  // checked by the parser
   install_signal_handlers();
   try {
-    return parsed.options.replay.empty() ? run(parsed.options) : run_replay(parsed.options);
+    return parsed.options.replay.empty() ? run(parsed.options) : rfbsim::sim::run_replay(parsed.options, g_stop);
   } catch (const rfbsim::replay::RecordingError& error) {
     std::fprintf(stderr, "sim_rfb: replay: %s\n", error.what());
     return 2;
