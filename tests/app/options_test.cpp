@@ -121,3 +121,15 @@ TEST_CASE("the end grace option takes whole seconds from 0 to 3600 and is unset 
   CHECK(parse_sim_options({"--end-grace", "-1"}).error == "bad value '-1' for --end-grace");
   CHECK(parse_sim_options({"--end-grace", "2.5"}).error == "bad value '2.5' for --end-grace");
 }
+
+TEST_CASE("the camera option takes third_person or first_person and is unset by default (the scenario's)") {
+  CHECK_FALSE(parse_sim_options({}).options.camera.has_value());
+  for (const char* camera : {"third_person", "first_person"}) {
+    const auto o = parse_sim_options({"--camera", camera});
+    REQUIRE(o.error.empty());
+    CHECK(o.options.camera == camera);
+  }
+  CHECK(parse_sim_options({"--camera", "overhead"}).error ==
+        "bad value 'overhead' for --camera (expected third_person or first_person)");
+  CHECK(rfbsim::sim::sim_usage().find("--camera third_person|first_person") != std::string::npos);
+}
