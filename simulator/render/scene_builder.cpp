@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// build_scene: floor, walls, props, landmarks, robot, people, avatar, the debug overlay, camera (third or first person).
+// build_scene: floor, walls, props, landmarks, robot, people, avatar, the debug overlay, the camera.
 #include "render/scene_builder.hpp"
 
 #include <algorithm>

@@ -423,7 +423,9 @@ void apply_overrides(Scenario& scenario, const ScenarioOverrides& overrides) {
   }
   if (overrides.camera) {
     const auto mode = camera_mode_from_name(*overrides.camera);
-    if (!mode) throw ScenarioError("--camera: expected 'third_person' or 'first_person', got '" + *overrides.camera + "'");
+    if (!mode) {
+      throw ScenarioError("--camera: expected 'third_person' or 'first_person', got '" + *overrides.camera + "'");
+    }
     scenario.camera = *mode;
   }
   if (overrides.robot_start) scenario.robot.start = checked("--robot-start", *overrides.robot_start, kRobotClearance, nullptr);
