@@ -51,6 +51,15 @@ StartDecision StartAdmission::decide(const std::string& query, const std::string
   if (std::string problem = ros_request_problem(config_, *parsed.request); !problem.empty()) {
     return invalid_link(400, Rejection::kBadRequest, std::move(problem));
   }
+  // A study may fix the view for everyone: then a link that chooses one is refused, not silently overruled.
+  if (!config_.allow_camera_param) {
+    for (const auto& [name, value] : parsed.request->overrides) {
+      if (name != "camera") continue;
+      return invalid_link(400, Rejection::kBadRequest,
+                          "camera is not offered here: this study's sessions all have their scenario's view "
+                          "(allow_camera_param is off)");
+    }
+  }
   // A link published in the open can be given an end: exp, a Unix time, signed with the rest.
   if (config_.require_link_expiry && !parsed.request->expires_at) {
     return invalid_link(403, Rejection::kBadSignature,

@@ -39,7 +39,8 @@ class StartAdmission {
   explicit StartAdmission(const ManagerConfig& config);
 
   /// Decides on a /start with `query` (the raw query string) from `address` (the sender's abuse key) at
-  /// `now`, a link's expiry compared with `unix_now` (seconds). Takes one token of the address's bucket.
+  /// `now`, a link's expiry compared with `unix_now` (seconds). Takes one token of the address's bucket. A valid
+  /// `camera` is refused (400) where config.allow_camera_param is off.
   StartDecision decide(const std::string& query, const std::string& address,
                        std::chrono::steady_clock::time_point now, long long unix_now);
 

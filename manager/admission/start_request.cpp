@@ -11,6 +11,7 @@ namespace rfbsim::manager {
 const std::vector<OverrideParam> kOverrideParams = {
     {"avatar_start", "--avatar-start"}, {"avatar_goal", "--avatar-goal"}, {"robot_start", "--robot-start"},
     {"robot_goal", "--robot-goal"},     {"crowd", "--crowd"},       {"robot_control", "--robot-control"},
+    {"camera", "--camera"},
 };
 
 namespace {
@@ -158,6 +159,14 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
         }
         continue;
       }
+      // The participant's view (issue 33); a study that fixes it refuses the parameter (StartAdmission).
+      if (name == "camera") {
+        if (value != "third_person" && value != "first_person") {
+          out.error = "camera '" + shown(value) + "' is not valid: use third_person or first_person";
+          return out;
+        }
+        continue;
+      }
       const bool crowd = name == "crowd";
       if (crowd ? !is_count(value, kMaxCrowd) : !is_pose(value)) {
         out.error = name + " '" + shown(value) + "' is not valid: " +
@@ -199,7 +208,7 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
       out.request.reset();
       return out;
     }
-    if (name == "robot_control") continue;  // a mode, not a pose
+    if (name == "robot_control" || name == "camera") continue;  // modes, not poses
     if (!names_spawn(value) || std::count(known->spawns.begin(), known->spawns.end(), value) > 0) continue;
     std::string names;
     for (const std::string& spawn : known->spawns) names += (names.empty() ? "" : ", ") + spawn;

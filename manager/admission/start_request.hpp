@@ -36,7 +36,7 @@ struct StartRequest {
 };
 
 /// The link parameters that override the scenario, with the sim_rfb flag each becomes: the poses, crowd (0..500)
-/// and robot_control (builtin or external).
+/// robot_control (builtin or external) and camera (third_person or first_person).
 struct OverrideParam {
   const char* name;  ///< in the link, e.g. "avatar_start"
   const char* flag;  ///< for sim_rfb, e.g. "--avatar-start"

@@ -129,6 +129,7 @@ struct ManagerConfig {
   std::string link_secret;                   ///< non-empty = /start links must carry a valid sig
   bool require_link_expiry = false;          ///< with a link secret: links must carry exp (a Unix time, seconds)
   bool allow_repeat = false;                 ///< a uid whose session ended may start another
+  bool allow_camera_param = true;            ///< links may choose the view (camera=third_person|first_person)
   std::string host_id;                       ///< recorded in the index; empty = this machine's host name
   std::string web_root;                      ///< participant page; empty = the built or installed one
   /// This host's own public origin (e.g. https://h2.study.example.org); when set, /start redirects there,

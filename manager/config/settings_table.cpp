@@ -238,6 +238,8 @@ std::vector<Setting> build_table() {
       row("require_link_expiry", boolean(&ManagerConfig::require_link_expiry),
           "with `link_secret`: links must carry a signed `exp` (a Unix time, seconds), and expire then"),
       row("allow_repeat", boolean(&ManagerConfig::allow_repeat), "a uid whose session ended may start another"),
+      row("allow_camera_param", boolean(&ManagerConfig::allow_camera_param),
+          "links may choose the participant's view with `camera`; off, such a link is refused (400)"),
       row("host_id",
           checked_text(&ManagerConfig::host_id, "ID", "",
                        [](const std::string& value) -> std::string {

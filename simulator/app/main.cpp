@@ -93,6 +93,7 @@ rfbsim::sim::SessionSetup setup_of(const rfbsim::sim::SimOptions& options) {
   }
   if (options.crowd) setup.parameters.emplace_back("crowd", std::to_string(*options.crowd));
   if (options.robot_control) setup.parameters.emplace_back("robot_control", *options.robot_control);
+  if (options.camera) setup.parameters.emplace_back("camera", *options.camera);
   return setup;
 }
 
@@ -195,6 +196,7 @@ int run(const rfbsim::sim::SimOptions& options) {
   const auto frame_interval = std::chrono::nanoseconds(1'000'000'000LL / options.fps);
   sim::SceneStyle scene_style;
   scene_style.debug_overlay = options.debug_overlay;
+  scene_style.camera = prepared.camera;
   std::uint64_t frames_rendered = 0;
   sim::FramePainter painter(gl, scene_style);
   // Draws the world and the HUD and hands the frame to the server, unless it would look as the last one (which

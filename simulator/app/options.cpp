@@ -125,6 +125,10 @@ void declare_sim_options(CLI::App& app, SimOptions& o) {
                              "who drives the robot: builtin (its own navigation stack) or external (/cmd_vel over\n"
                              "rosbridge drives it; it stops 0.5 s after the last command) (default: the scenario's)"),
               {"builtin", "external"});
+  cli::one_of(app.add_option("--camera", o.camera,
+                             "the participant's view: third_person (behind the avatar) or first_person (from its\n"
+                             "eyes, its body not drawn) (default: the scenario's camera, else third_person)"),
+              {"third_person", "first_person"});
 
   // The study's records.
   app.add_option("--data-dir", o.data_dir,

@@ -57,6 +57,8 @@ struct SimOptions {
   bool mcap = true;                 ///< with data_dir, also write session.mcap (--no-mcap: not)
   /// Who drives the robot: "builtin" or "external" (a link parameter like the poses; unset = the scenario's).
   std::optional<std::string> robot_control;
+  /// The participant's view: "third_person" or "first_person" (a link parameter too; unset = the scenario's).
+  std::optional<std::string> camera;
   /// ROS (docs/ros.md): a rosbridge v2 server on this port (0 = any free port), unauthenticated, so loopback
   /// by default; and/or a rosbridge client dialling out to `rosbridge_connect` (ws:// or wss://).
   std::optional<int> rosbridge_port;

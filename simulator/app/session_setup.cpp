@@ -26,6 +26,8 @@ ScenarioOverrides overrides_of(const SessionSetup& setup) {
       overrides.robot_goal = value;
     } else if (name == "robot_control") {
       overrides.robot_control = value;
+    } else if (name == "camera") {
+      overrides.camera = value;
     } else if (name == "crowd") {
       int count = -1;
       const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), count);
@@ -56,7 +58,14 @@ PreparedSession prepare_session(const SessionSetup& setup) {
   info.rfbsim_version = rfbsim_version();
   info.build = rfbsim_build_id();
   if (setup.scenario.empty()) {
-    if (!setup.parameters.empty()) throw ScenarioError("the built-in test room takes no scenario parameters");
+    // The view is no part of the room: the test room takes --camera, and nothing else.
+    for (const auto& [name, value] : setup.parameters) {
+      if (name != "camera") throw ScenarioError("the built-in test room takes no scenario parameters");
+      const auto mode = camera_mode_from_name(value);
+      if (!mode) throw ScenarioError("--camera: expected 'third_person' or 'first_person', got '" + value + "'");
+      prepared.camera = *mode;
+    }
+    info.camera = std::string(camera_mode_name(prepared.camera));
     prepared.simulation = std::make_unique<Simulation>(params, make_demo_world());
     return prepared;
   }
@@ -78,6 +87,8 @@ PreparedSession prepare_session(const SessionSetup& setup) {
     info.end_grace = scenario.task.end_grace;
   }
   prepared.task = scenario.task;
+  prepared.camera = scenario.camera;
+  info.camera = std::string(camera_mode_name(scenario.camera));
   prepared.simulation = std::make_unique<Simulation>(params, make_world(scenario), scenario.crowd, robot_setup(scenario));
   return prepared;
 }

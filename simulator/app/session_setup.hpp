@@ -15,12 +15,14 @@
 #include "app/simulation.hpp"
 #include "record/session_writer.hpp"
 #include "task/task_spec.hpp"
+#include "world/camera_mode.hpp"
 
 namespace rfbsim::sim {
 
 struct SessionSetup {
   std::string scenario;  ///< name or path; empty = the built-in test room
-  /// Overrides as (link parameter, value): avatar_start, avatar_goal, robot_start, robot_goal, crowd.
+  /// Overrides as (link parameter, value): avatar_start, avatar_goal, robot_start, robot_goal, crowd,
+  /// robot_control, camera.
   std::vector<std::pair<std::string, std::string>> parameters;
   std::optional<std::uint64_t> seed;  ///< unset = the scenario's (and its crowd's own, if it has one)
   int tick_hz = 60;
@@ -32,6 +34,7 @@ struct SessionSetup {
 struct PreparedSession {
   std::unique_ptr<Simulation> simulation;
   TaskSpec task;
+  CameraMode camera = CameraMode::kThirdPerson;  ///< the participant's view: the scenario's, or the override
   /// session.json's header, less what the caller knows (uid, fps, frame, codes). Its parameters are the
   /// setup's, plus "seed" when the setup gave one: what a replay needs to build the same world (a seed
   /// override also replaces a crowd's own seed, so "given" and "the file's" are not the same).

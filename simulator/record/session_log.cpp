@@ -200,6 +200,13 @@ SessionMeta parse_meta(const json& doc, const Where& where) {
   if (const auto grace = doc.find("end_grace_s"); grace != doc.end() && !grace->is_null()) {
     meta.end_grace_s = get_number(doc, "end_grace_s", where);
   }
+  // Optional: sessions recorded before the first-person view had the third-person one.
+  if (const auto camera = doc.find("camera"); camera != doc.end() && !camera->is_null()) {
+    const std::string name = get_string(doc, "camera", where);
+    const auto mode = camera_mode_from_name(name);
+    if (!mode) wrong("camera", "'third_person' or 'first_person'", where);
+    meta.camera = *mode;
+  }
   if (!need(doc, "codes", where).is_null()) {
     const json& codes = get_object(doc, "codes", where);
     meta.success_code = get_optional_string(codes, "success", where);

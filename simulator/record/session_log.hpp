@@ -15,6 +15,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "world/camera_mode.hpp"
+
 namespace rfbsim::sim {
 
 /// A session folder's content is not what docs/data.md describes. The message names the file, the line
@@ -78,6 +80,7 @@ struct SessionMeta {
   std::optional<double> time_limit_s;  ///< s; none without tasks
   std::optional<double> end_grace_s;   ///< s from the outcome to the end; none without tasks or in older files
   std::optional<std::string> success_code, timeout_code;  ///< the link's completion codes, if any
+  CameraMode camera = CameraMode::kThirdPerson;  ///< the participant's view; third_person in older files
   std::string started_at;                ///< ISO 8601 UTC
   std::optional<std::string> ended_at;   ///< none while running or after a crash
   std::optional<std::uint64_t> end_tick;  ///< the last tick simulated, after a clean end

@@ -115,6 +115,7 @@ SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const 
               {"codes", info_.codes ? json{{"success", info_.codes->first}, {"timeout", info_.codes->second}}
                                     : json(nullptr)},
               {"robot_control", info_.robot_control.empty() ? json(nullptr) : json(info_.robot_control)},
+              {"camera", info_.camera},
               {"ros",
                {{"bag", info_.ros_bag.empty() ? json(nullptr) : json(info_.ros_bag)},
                 {"bridge", info_.ros_bridge.empty() ? json(nullptr) : json(info_.ros_bridge)},

@@ -41,6 +41,7 @@ struct SessionInfo {
   std::optional<double> end_grace;   ///< s from the outcome to the session's end; none without a task
   std::optional<std::pair<std::string, std::string>> codes;  ///< (success, timeout)
   std::string robot_control;  ///< who drives the robot: "builtin" or "external"; empty = no robot
+  std::string camera = "third_person";  ///< the participant's view: "third_person" or "first_person"
   /// What the session gave ROS (docs/ros.md): the bag's file name, the bridge ("server ADDR:PORT" or
   /// "client URL") and the topics' namespace; empty = none.
   std::string ros_bag, ros_bridge, ros_namespace;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// build_scene: floor, walls, props, landmarks, robot, people, avatar, the debug overlay, camera.
+// build_scene: floor, walls, props, landmarks, robot, people, avatar, the debug overlay, the camera.
 #include "render/scene_builder.hpp"
 
 #include <algorithm>
@@ -73,6 +73,17 @@ void append_top_view_marker(std::vector<DrawItem>& items, const Eigen::Vector3f&
 
 }  // namespace
 
+ViewCamera first_person_camera(const Avatar& avatar, const SceneStyle& style) {
+  constexpr float kGazeDown = 10.0f * std::numbers::pi_v<float> / 180.0f;
+  const auto yaw = static_cast<float>(avatar.pose.yaw);
+  ViewCamera camera;
+  camera.eye = {static_cast<float>(avatar.pose.x), static_cast<float>(avatar.pose.y), style.eye_height};
+  // A target 1 m away along the gaze: look_at needs only the direction.
+  camera.target = camera.eye + Eigen::Vector3f(std::cos(kGazeDown) * std::cos(yaw), std::cos(kGazeDown) * std::sin(yaw),
+                                               -std::sin(kGazeDown));
+  return camera;
+}
+
 Scene build_scene(const World& world, const SceneStyle& style) {
   Scene scene;
   const GridMap& map = world.map;
@@ -109,14 +120,18 @@ Scene build_scene(const World& world, const SceneStyle& style) {
   if (world.robot) append_robot(scene.items, *world.robot);
   for (const Person& person : world.people) append_person(scene.items, person);
 
-  // The avatar, and a soft shadow under it that anchors it to the floor.
+  // The avatar, and a soft shadow under it that anchors it to the floor; not in first person, where the
+  // camera sits inside its head and its body would fill the picture.
   const Avatar& avatar = world.avatar;
   const Eigen::Vector3f feet{static_cast<float>(avatar.pose.x), static_cast<float>(avatar.pose.y), 0.0f};
   const auto yaw = static_cast<float>(avatar.pose.yaw);
-  const float swing = std::min(1.0f, static_cast<float>(std::abs(avatar.speed)) / 1.3f);
-  append_humanoid(scene.items, feet, yaw, static_cast<float>(avatar.gait_phase), swing, style.avatar_height,
-                  rgb(0x2f7fd0));
-  append_soft_shadow(scene.items, feet.x(), feet.y(), 0.4f);
+  const bool first_person = !style.top_view && style.camera == CameraMode::kFirstPerson;
+  if (!first_person) {
+    const float swing = std::min(1.0f, static_cast<float>(std::abs(avatar.speed)) / 1.3f);
+    append_humanoid(scene.items, feet, yaw, static_cast<float>(avatar.gait_phase), swing, style.avatar_height,
+                    rgb(0x2f7fd0));
+    append_soft_shadow(scene.items, feet.x(), feet.y(), 0.4f);
+  }
 
   // From above, a ring marks the avatar (the participant view has none).
   if (style.top_view) append_top_view_marker(scene.items, feet, rgb(0x2f7fd0));
@@ -126,6 +141,10 @@ Scene build_scene(const World& world, const SceneStyle& style) {
 
   if (style.top_view) {
     place_top_camera(scene, map, style);
+    return scene;
+  }
+  if (first_person) {
+    scene.camera = first_person_camera(avatar, style);
     return scene;
   }
 

@@ -4,6 +4,7 @@
 
 #include "render/draw_list.hpp"
 #include "render/nav_overlay.hpp"
+#include "world/camera_mode.hpp"
 #include "world/world.hpp"
 
 namespace rfbsim::sim {
@@ -17,6 +18,9 @@ struct SceneStyle {
   /// A bird's-eye camera straight down over the whole map (sim_replay's top view) instead of the
   /// participant's third-person camera, with a ring under the avatar so that it can be found from above.
   bool top_view = false;
+  /// The participant's view when not `top_view`: behind the avatar, or from its eyes without its body.
+  CameraMode camera = CameraMode::kThirdPerson;
+  float eye_height = 1.62f;  ///< m above the floor: first person's eye (a little under the head's top)
   float top_view_aspect = 16.0f / 9.0f;  ///< the frame's width / height, which the top view fits the map into
 };
 
@@ -25,8 +29,14 @@ struct SceneStyle {
 /// With `style.debug_overlay` and a robot, the navigation overlay (nav_overlay.hpp) follows as the last items;
 /// without, the scene is exactly what it is without the overlay code. With `style.top_view` the camera looks
 /// straight down on the map's centre (map +y up in the picture), high enough that the whole map and its
-/// walls fit a frame of `top_view_aspect`, and there is no fog.
+/// walls fit a frame of `top_view_aspect`, and there is no fog. With `style.camera` first person (and no top
+/// view) the camera is first_person_camera's and the avatar and its shadow are left out.
 Scene build_scene(const World& world, const SceneStyle& style = {});
+
+/// The first-person camera of `avatar`: the eye `style.eye_height` above its feet, looking along its yaw,
+/// the gaze 10 degrees below the horizon (a walker watches the floor ahead). The rig's height (Up/Down) does not
+/// move it.
+ViewCamera first_person_camera(const Avatar& avatar, const SceneStyle& style);
 
 /// How one humanoid looks: colours (RGB 0..1) and how broad it is.
 struct HumanoidLook {

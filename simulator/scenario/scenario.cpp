@@ -280,10 +280,16 @@ Pose2 resolve_override(const Scenario& scenario, const std::string& option, cons
 Scenario load_scenario(const std::filesystem::path& file) {
   const YamlField root = read_yaml_file(file);
   if (!root.is_mapping()) root.fail("a mapping of scenario keys");
-  root.allow_only({"name", "description", "map", "seed", "props", "landmarks", "spawns", "crowd", "robot", "avatar", "task"});
+  root.allow_only({"name", "description", "map", "seed", "props", "landmarks", "spawns", "crowd", "robot", "avatar", "task",
+                   "camera"});
   Scenario scenario;
   scenario.file = file;
   scenario.name = root.optional("name") ? root.required("name").text() : file.stem().string();
+  if (auto camera = root.optional("camera")) {
+    const auto mode = camera_mode_from_name(camera->text());
+    if (!mode) camera->fail_with("expected 'third_person' or 'first_person'");
+    scenario.camera = *mode;
+  }
 
   // The map first: every pose below is checked against it.
   const YamlField map_field = root.required("map");
@@ -414,6 +420,13 @@ void apply_overrides(Scenario& scenario, const ScenarioOverrides& overrides) {
       throw ScenarioError("--robot-control: expected 'builtin' or 'external', got '" + *overrides.robot_control + "'");
     }
     scenario.robot.control = *control;
+  }
+  if (overrides.camera) {
+    const auto mode = camera_mode_from_name(*overrides.camera);
+    if (!mode) {
+      throw ScenarioError("--camera: expected 'third_person' or 'first_person', got '" + *overrides.camera + "'");
+    }
+    scenario.camera = *mode;
   }
   if (overrides.robot_start) scenario.robot.start = checked("--robot-start", *overrides.robot_start, kRobotClearance, nullptr);
   if (overrides.robot_goal) {

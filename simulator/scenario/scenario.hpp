@@ -16,6 +16,7 @@
 #include "robot/mission.hpp"
 #include "robot/robot_stack.hpp"
 #include "task/task_spec.hpp"
+#include "world/camera_mode.hpp"
 #include "world/world.hpp"
 
 namespace rfbsim::sim {
@@ -57,6 +58,7 @@ struct Scenario {
   std::optional<Landmark> avatar_goal;  ///< drawn as a landmark; what the participant walks to
   std::uint64_t seed = 1;               ///< master seed; the crowd's comes from it unless given
   TaskSpec task;                        ///< the participant's task; no steps = none (reach targets resolved)
+  CameraMode camera = CameraMode::kThirdPerson;  ///< `camera`: the participant's view
 };
 
 /// Loads and checks a scenario file and its map. Throws ScenarioError (never anything else for bad
@@ -78,6 +80,7 @@ struct ScenarioOverrides {
   std::optional<std::uint64_t> seed;
   std::optional<int> crowd_count;
   std::optional<std::string> robot_control;  ///< "builtin" or "external" (--robot-control, the link's robot_control)
+  std::optional<std::string> camera;         ///< "third_person" or "first_person" (--camera, the link's camera)
 };
 
 /// Applies overrides and re-checks the poses against the map. Throws ScenarioError naming the option

@@ -136,3 +136,15 @@ TEST_CASE("the replay option takes a session folder and refuses options that wou
     CHECK(both.error.find(other) != std::string::npos);
   }
 }
+
+TEST_CASE("the camera option takes third_person or first_person and is unset by default (the scenario's)") {
+  CHECK_FALSE(parse_sim_options({}).options.camera.has_value());
+  for (const char* camera : {"third_person", "first_person"}) {
+    const auto o = parse_sim_options({"--camera", camera});
+    REQUIRE(o.error.empty());
+    CHECK(o.options.camera == camera);
+  }
+  CHECK(parse_sim_options({"--camera", "overhead"}).error ==
+        "bad value 'overhead' for --camera (expected third_person or first_person)");
+  CHECK(rfbsim::sim::sim_usage().find("--camera third_person|first_person") != std::string::npos);
+}

@@ -64,6 +64,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     last = index;
     const bool valid = name == "crowd"           ? is_count(value)
                        : name == "robot_control" ? (value == "builtin" || value == "external")
+                       : name == "camera"        ? (value == "third_person" || value == "first_person")
                                                  : is_pose(value);
     check(valid, "override value not valid");
   }

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // sim_replay --video: an H.264 MP4 at the recorded frame size and rate with one frame per 1/fps of the
 // session, read back by ffprobe and decoded by ffmpeg; the top view shows another picture than the
-// participant's; a video of a replay that departs from the log, or one that cannot be written, is not left.
+// participant's, and a first-person session is filmed from its own camera; a video of a replay that departs from
+// the log, or one that cannot be written, is not left.
 #include <catch2/catch.hpp>
 
 #include <sys/wait.h>
@@ -9,6 +10,8 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "file_text.hpp"
@@ -149,4 +152,33 @@ TEST_CASE("no video is left when the replay departs from the log or the file can
     CHECK(run.exit_code == 1);
     CHECK(contains(run.output, "video: " + video.string() + ": cannot open for writing (No such file or directory)"));
   }
+}
+
+TEST_CASE("the participant video of a first-person session is filmed from the camera session.json names") {
+  if (!have_ffmpeg()) RFBSIM_SKIP("ffprobe or ffmpeg not found at configure time (apt-get install ffmpeg)");
+  const auto dir = test::fresh_dir("video_first_person");
+  test::RecordSpec spec;
+  spec.parameters = {{"camera", "first_person"}};
+  spec.max_ticks = 60;
+  (void)test::record_session(spec, dir);
+  // The same session with the key saying third_person: the world replays the same (the parameters are
+  // unchanged), and only the film's camera follows the key.
+  const auto third = test::copy_session(dir, "video_first_person_as_third");
+  json session = json::parse(std::ifstream(third / "session.json"));
+  REQUIRE(session["camera"] == "first_person");
+  session["camera"] = "third_person";
+  std::ofstream(third / "session.json") << session.dump(2) << "\n";
+
+  std::vector<std::string> frames;
+  for (const auto& [folder, name] : {std::pair{dir, "fp"}, std::pair{third, "tp"}}) {
+    const auto video = dir.parent_path() / (std::string(name) + ".mp4");
+    const test::ReplayRun run = test::run_replay({folder.string(), "--video", video.string()});
+    INFO(run.output);
+    REQUIRE(run.exit_code == 0);
+    frames.push_back(decoded_frame(video, 20, dir.parent_path() / (std::string(name) + ".rgb")));
+  }
+  REQUIRE(frames[0].size() == 320u * 240u * 3u);
+  REQUIRE(frames[1].size() == frames[0].size());
+  CHECK(spread(frames[0]) > 10.0);
+  CHECK(mean_abs_difference(frames[0], frames[1]) > 5.0);
 }

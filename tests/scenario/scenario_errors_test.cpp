@@ -165,3 +165,34 @@ TEST_CASE("no file is read when the scenario file itself is missing") {
     CHECK_THAT(e.what(), Catch::Contains("/nonexistent/dir/s.yaml") && Catch::Contains("cannot open"));
   }
 }
+
+TEST_CASE("camera is third_person unless the file or an override says first_person, and nothing else") {
+  ScratchScenario scratch;
+  scratch.write("s.yaml", kValid);
+  CHECK(load_scenario(scratch.dir() / "s.yaml").camera == CameraMode::kThirdPerson);
+  scratch.write("s.yaml", kValid + "camera: first_person\n");
+  Scenario first = load_scenario(scratch.dir() / "s.yaml");
+  CHECK(first.camera == CameraMode::kFirstPerson);
+  scratch.write("s.yaml", kValid + "camera: third_person\n");
+  CHECK(load_scenario(scratch.dir() / "s.yaml").camera == CameraMode::kThirdPerson);
+
+  // A bad value names the file, the key, what is allowed and what was given; so does a bad override.
+  for (const char* bad : {"fisrt_person", "First_Person", "overhead"}) {
+    INFO(bad);
+    const std::string message = scratch.error_of(kValid + "camera: " + bad + "\n");
+    CHECK_THAT(message, Catch::Contains("s.yaml") && Catch::Contains("key 'camera'") &&
+                            Catch::Contains("'third_person' or 'first_person'"));
+  }
+  ScenarioOverrides to_third;
+  to_third.camera = "third_person";
+  apply_overrides(first, to_third);
+  CHECK(first.camera == CameraMode::kThirdPerson);
+  ScenarioOverrides bad;
+  bad.camera = "overhead";
+  try {
+    apply_overrides(first, bad);
+    FAIL("no error for --camera overhead");
+  } catch (const ScenarioError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("--camera") && Catch::Contains("'overhead'"));
+  }
+}

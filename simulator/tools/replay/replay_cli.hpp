@@ -13,7 +13,7 @@ namespace rfbsim::replay {
 
 /// Which camera the video shows.
 enum class View {
-  Participant,  ///< what the participant saw: the third-person camera behind the avatar
+  Participant,  ///< what the participant saw: session.json's camera (third or first person) and the HUD
   Top,          ///< a bird's-eye view of the whole map (SceneStyle::top_view)
 };
 

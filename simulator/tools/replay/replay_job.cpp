@@ -166,10 +166,7 @@ struct Film {
     gl_options.width = meta.frame_width;
     gl_options.height = meta.frame_height;
     gl = std::make_unique<rfbsim::OffscreenGL>(gl_options);
-    sim::SceneStyle style;
-    style.top_view = options.view == View::Top;
-    style.top_view_aspect = static_cast<float>(meta.frame_width) / static_cast<float>(meta.frame_height);
-    painter = std::make_unique<sim::FramePainter>(*gl, style);
+    painter = std::make_unique<sim::FramePainter>(*gl, video_style(options.view, meta));
   }
   ~Film() {
     painter.reset();  // its GL objects go while the context lives
@@ -287,6 +284,17 @@ void run_job(const ReplayOptions& options, const ProgressFn& progress, ReplayRes
 }
 
 }  // namespace
+
+sim::SceneStyle video_style(View view, const sim::SessionMeta& meta) {
+  sim::SceneStyle style;
+  style.top_view = view == View::Top;
+  if (meta.frame_height > 0) {
+    style.top_view_aspect = static_cast<float>(meta.frame_width) / static_cast<float>(meta.frame_height);
+  }
+  // The view the participant had, from the file rather than from the scenario as it reads today.
+  style.camera = meta.camera;
+  return style;
+}
 
 ReplayResult replay_session(const ReplayOptions& options, const ProgressFn& progress) {
   ReplayResult result;

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "record/session_log.hpp"
+#include "render/scene_builder.hpp"
 #include "replay_cli.hpp"
 
 namespace rfbsim::replay {
@@ -41,6 +43,10 @@ struct ReplayResult {
 
 /// Called now and then during the replay with the simulated seconds done and in all.
 using ProgressFn = std::function<void(double done_s, double total_s)>;
+
+/// How the video draws `meta`'s session under `view`: the participant's camera as session.json's `camera`
+/// recorded it (third person for files older than the key), or the top view fitted to the recorded frame.
+sim::SceneStyle video_style(View view, const sim::SessionMeta& meta);
 
 /// Replays `options.session_dir` as `options` say. Never throws: every failure is a result with its exit
 /// status and message.

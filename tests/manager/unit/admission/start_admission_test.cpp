@@ -32,6 +32,23 @@ TEST_CASE("admission: a plain link is admitted with its uid and scenario") {
   CHECK(decision.request->scenario == "lab");
 }
 
+TEST_CASE("admission: camera is admitted unless allow_camera_param is off, then refused with a 400") {
+  ManagerConfig config;
+  const StartDecision allowed = decide_once(config, "uid=p01&scenario=lab&camera=first_person");
+  REQUIRE(allowed.kind == Kind::kAdmitted);
+  CHECK(allowed.request->overrides == std::vector<std::pair<std::string, std::string>>{{"camera", "first_person"}});
+  config.allow_camera_param = false;
+  for (const char* query : {"uid=p01&scenario=lab&camera=first_person", "uid=p01&camera=third_person"}) {
+    CAPTURE(query);
+    const StartDecision refused = decide_once(config, query);
+    REQUIRE(refused.kind == Kind::kRefused);
+    CHECK(refused.status == 400);
+    CHECK(refused.rejection == Rejection::kBadRequest);
+    CHECK(refused.message.find("camera is not offered here") != std::string::npos);
+  }
+  CHECK(decide_once(config, "uid=p01&scenario=lab").kind == Kind::kAdmitted);
+}
+
 TEST_CASE("admission: a malformed query, a bad parameter and an unknown scenario are 400s that say why") {
   const ManagerConfig config;
   for (const char* query : {"uid=p%ZZ", "uid=p 01", "uid=p01&scenario=moon", "scenario=lab"}) {

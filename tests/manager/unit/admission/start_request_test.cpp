@@ -87,7 +87,7 @@ TEST_CASE("overrides come out in the order of kOverrideParams whatever the link'
 }
 
 TEST_CASE("the override parameters and their sim_rfb flags") {
-  REQUIRE(kOverrideParams.size() == 6);
+  REQUIRE(kOverrideParams.size() == 7);
   CHECK(std::string(kOverrideParams[0].name) == "avatar_start");
   CHECK(std::string(kOverrideParams[0].flag) == "--avatar-start");
   CHECK(std::string(kOverrideParams[1].name) == "avatar_goal");
@@ -100,6 +100,29 @@ TEST_CASE("the override parameters and their sim_rfb flags") {
   CHECK(std::string(kOverrideParams[4].flag) == "--crowd");
   CHECK(std::string(kOverrideParams[5].name) == "robot_control");
   CHECK(std::string(kOverrideParams[5].flag) == "--robot-control");
+  CHECK(std::string(kOverrideParams[6].name) == "camera");
+  CHECK(std::string(kOverrideParams[6].flag) == "--camera");
+}
+
+TEST_CASE("camera is third_person or first_person, exactly, and needs no robot or spawn point") {
+  for (const char* value : {"third_person", "first_person"}) {
+    const StartParse parsed = parse_with("camera", value);
+    REQUIRE(parsed.request);
+    CHECK(parsed.request->overrides == std::vector<std::pair<std::string, std::string>>{{"camera", value}});
+    // An identifier, yet not a pose: the scenario's spawn points are not asked about it.
+    rfbsim::manager::ScenarioFacts facts;
+    facts.name = "lab";
+    facts.spawns = {"door"};
+    const StartParse checked = parse_start_request({{"uid", "p01"}, {"scenario", "lab"}, {"camera", value}},
+                                                   kScenarios, {facts});
+    CHECK(checked.request);
+    CHECK(checked.error.empty());
+  }
+  for (const char* value : {"", "First_person", "first-person", "first_person ", "overhead", "1,2,0"}) {
+    INFO(value);
+    CHECK(parse_with("camera", value).error ==
+          "camera '" + std::string(value) + "' is not valid: use third_person or first_person");
+  }
 }
 
 TEST_CASE("robot_control is builtin or external, exactly") {

@@ -280,6 +280,15 @@ TEST_CASE("the link's robot_control reaches sim_rfb as --robot-control, with or 
   CHECK(session_ros(config, request("hall"), 12).robot_control.empty());
 }
 
+TEST_CASE("the link's camera reaches sim_rfb as --camera, last of the overrides, and the index's parameters") {
+  const ManagerConfig config = ros_config();
+  StartRequest r = request("depot");
+  r.overrides = {{"crowd", "3"}, {"camera", "first_person"}};
+  const LaunchContext context{7, 0, "/data/p01-1", "", 12};
+  CHECK(middle(session_arguments(config, r, context)) == Args{"--crowd", "3", "--camera", "first_person"});
+  CHECK(parameters_json(r, 7) == R"({"uid":"p01","scenario":"depot","seed":"7","crowd":"3","camera":"first_person"})");
+}
+
 TEST_CASE("with a ros section a robot scenario's session dials out to the lab under its own namespace") {
   ManagerConfig config = ros_config();
   config.ros.connect = "wss://ros.lab.example.org:9090/";
