@@ -84,6 +84,8 @@ int run_replay(const SimOptions& options, const std::atomic<bool>& stop) {
   FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / meta.tick_hz));
   SceneStyle scene_style;
   scene_style.debug_overlay = options.debug_overlay;
+  // The watcher sees the view the walker had (session.json's camera: first or third person).
+  scene_style.camera = meta.camera;
   FramePainter painter(gl, scene_style);
   std::uint64_t frames_rendered = 0;
   const auto draw = [&](bool always) {

@@ -9,7 +9,7 @@
 #include "record/session_log.hpp"
 #include "replay_fixtures.hpp"
 #include "replay_job.hpp"
-#include "session_replay.hpp"
+#include "replay/session_replay.hpp"
 
 using namespace rfbsim;
 using nlohmann::json;

@@ -3,6 +3,7 @@
 // keys is played by a second sim_rfb to a watcher B, started as sim_manager starts it (--ready-fd). B's picture
 // at the recording's end matches sim_replay's video frame of A there, within the replay check's limits; B's own
 // keys and pointer change nothing; B ends with "outcome watched" on the ready pipe; and A's folder is untouched.
+// Once with A in the third-person view and once in the first-person one: B sees the view A had.
 //
 // Which tick a served picture shows: the stream does not say, so the picture compared is the last one. At the
 // recording's end sim_rfb draws the end tick, then writes the outcome line, then holds the picture
@@ -58,10 +59,10 @@ void hold_key(test::RfbTestClient& client, std::uint32_t keysym, std::chrono::mi
 }
 
 // Records session A in `dir` with a real sim_rfb and a real client walking, turning, then standing still.
-void record_walk(const std::filesystem::path& dir) {
+void record_walk(const std::filesystem::path& dir, const std::string& camera) {
   test::SimProcess sim(test::sim_rfb_path(), {"--port", "0", "--scenario", RFBSIM_STILL_SCENARIO, "--data-dir",
                                               dir.string(), "--width", std::to_string(kWidth), "--height",
-                                              std::to_string(kHeight), "--uid", "p-walker"});
+                                              std::to_string(kHeight), "--uid", "p-walker", "--camera", camera});
   test::RfbTestClient client("127.0.0.1", sim.port());
   REQUIRE(client.wait_for_updates(1, std::chrono::seconds(20)));
   hold_key(client, 'w', std::chrono::milliseconds(1500));
@@ -84,9 +85,13 @@ const sim::TrajectoryRow& last_avatar(const sim::SessionLog& log) {
 TEST_CASE("sim_rfb --replay shows a recorded session to its end as sim_replay films it, ignores the watcher, ends watched",
           "[waits]") {
   if (std::string(RFBSIM_FFMPEG).empty()) RFBSIM_SKIP("ffmpeg not found at configure time (apt-get install ffmpeg)");
-  const auto a_dir = test::fresh_dir("watched_a");
-  record_walk(a_dir);
+  // The watcher sees the view the walker had: the third-person camera, or the first-person one.
+  const std::string camera = GENERATE(std::string("third_person"), std::string("first_person"));
+  INFO("camera " << camera);
+  const auto a_dir = test::fresh_dir("watched_a_" + camera);
+  record_walk(a_dir, camera);
   const sim::SessionLog a = sim::read_session(a_dir);
+  REQUIRE(sim::camera_mode_name(a.meta.camera) == camera);
   REQUIRE(a.meta.end_tick.has_value());
   REQUIRE(a.meta.tick_hz == 60);
   REQUIRE(a.meta.fps == 30);
@@ -96,20 +101,21 @@ TEST_CASE("sim_rfb --replay shows a recorded session to its end as sim_replay fi
   const std::map<std::string, std::string> a_before = folder_bytes(a_dir);
 
   // sim_replay's video of A: frame k shows tick 2k; the last frame is the last even tick before the end.
-  const auto video = a_dir.parent_path() / "watched_a.mp4";
+  const auto video = a_dir.parent_path() / ("watched_a_" + camera + ".mp4");
   const test::ReplayRun filmed = test::run_replay({a_dir.string(), "--video", video.string(), "-q"});
   INFO(filmed.output);
   REQUIRE(filmed.exit_code == 0);
   const std::uint64_t last_frame = (*a.meta.end_tick - 1) / 2;
   const std::vector<test::Pixels> frames =
-      test::decoded_frames(video, {0, last_frame}, kWidth, kHeight, a_dir.parent_path() / "watched_a.rgb");
+      test::decoded_frames(video, {0, last_frame}, kWidth, kHeight,
+                           a_dir.parent_path() / ("watched_a_" + camera + ".rgb"));
 
   // B: the replay, as sim_manager would start it, with a watcher's data folder of its own.
-  const auto b_dir = test::fresh_dir("watched_b");
+  const auto b_dir = test::fresh_dir("watched_b_" + camera);
   test::PipedSim b(test::sim_rfb_path(),
                    {"--replay", a_dir.string(), "--port", "0", "--data-dir", b_dir.string(), "--uid", "w-watcher",
                     "--end-grace", "600"},
-                   {}, a_dir.parent_path() / "watched_b.log");
+                   {}, a_dir.parent_path() / ("watched_b_" + camera + ".log"));
   const std::string ready = b.await_line("ready ", std::chrono::seconds(60));
   REQUIRE(!ready.empty());
   const int port = std::stoi(ready.substr(6));
@@ -187,5 +193,5 @@ TEST_CASE("sim_rfb --replay shows a recorded session to its end as sim_replay fi
   std::filesystem::remove_all(a_dir);
   std::filesystem::remove_all(b_dir);
   std::filesystem::remove(video);
-  std::filesystem::remove(a_dir.parent_path() / "watched_a.rgb");
+  std::filesystem::remove(a_dir.parent_path() / ("watched_a_" + camera + ".rgb"));
 }
