@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <utility>
 
 #include "task/task_display.hpp"
 #include "task/task_monitor.hpp"
@@ -236,7 +237,10 @@ TEST_CASE("a spec without steps is inactive: no clock, no events, no outcome") {
   CHECK(task_text(TaskSpec{}, monitor.status(), "X").corner.empty());
 }
 
-TEST_CASE("the HUD says the step, the instruction, the progress and the time left, then the code") {
+namespace {
+
+// Two steps (find the robot, then follow it), 12.7 of 30 s into the second, 3:12 left: what both HUD texts show.
+std::pair<TaskSpec, TaskStatus> following_halfway() {
   TaskSpec spec;
   TaskStep find;
   find.type = TaskType::FindRobot;
@@ -249,6 +253,13 @@ TEST_CASE("the HUD says the step, the instruction, the progress and the time lef
   status.amount = 12.7;
   status.goal = 30.0;
   status.time_left = 191.2;
+  return {spec, status};
+}
+
+}  // namespace
+
+TEST_CASE("the HUD says the step, the instruction, the progress and the time left, then the code") {
+  auto [spec, status] = following_halfway();
   const TaskText running = task_text(spec, status, "");
   CHECK(running.corner ==
         std::vector<std::string>{"Task 2 of 2", "Follow the robot: stay close to it", "Following: 12 / 30 s", "Time left 3:12"});
@@ -262,18 +273,7 @@ TEST_CASE("the HUD says the step, the instruction, the progress and the time lef
 }
 
 TEST_CASE("a replay's watcher sees the step count, progress, time left and outcome, not the walker's prompts") {
-  TaskSpec spec;
-  TaskStep find;
-  find.type = TaskType::FindRobot;
-  TaskStep follow;
-  follow.type = TaskType::FollowRobot;
-  spec.steps = {find, follow};
-  TaskStatus status;
-  status.timer_running = true;
-  status.step = 1;
-  status.amount = 12.7;
-  status.goal = 30.0;
-  status.time_left = 191.2;
+  auto [spec, status] = following_halfway();
   CHECK(watched_task_text(spec, status).corner ==
         std::vector<std::string>{"Task 2 of 2", "Following: 12 / 30 s", "Time left 3:12"});
   status.step = 0;
