@@ -2,7 +2,7 @@
 // Browser end-to-end test of sim_manager: a real browser (Chromium, or Firefox ESR with --browser firefox) follows
 // participant links, sees the start-up progress and the first picture, walks, reloads, is embedded in a survey
 // (allowed and refused origins), is ended by the researcher through the admin API, and the admin page lists
-// sessions, watches one view-only and ends it. The stream the walking page got (codec, frame rate) is logged.
+// sessions, watches one view-only and ends it. The stream the walking page got (codec, quality, frame rate) is logged.
 //
 // Usage: node e2e_manager.mjs [--browser chromium|firefox] SIM_MANAGER SIM_RFB WEB_ROOT ARTIFACTS_DIR [WEB_DIR]
 //   SIM_MANAGER    the sim_manager executable to start
@@ -22,7 +22,6 @@ import os from 'node:os';
 import path from 'node:path';
 
 import { loadDriver } from './browser_driver.mjs';
-import { logAutoCodecStream } from './stream_probe.mjs';
 import {
   PIXEL_CHANGE_THRESHOLD, changedFraction, check, childrenOf, log, onCleanup, openPage, pageState,
   parseManagerArgs, poll, procInfo, recordPage, runTest, serveHtmlPage, sleep, snapshot, startSim,
@@ -72,7 +71,8 @@ async function listSessions() {
   return response.json();
 }
 
-// Logs the stream sim_rfb last reported for uid's live session (GET /api/sessions: codec, frame rate, round trip),
+// Logs the stream sim_rfb last reported for uid's live session (GET /api/sessions: codec, quality, frame rate, round
+// trip),
 // so that each run says what its browser was sent. sim_rfb reports about once a second while someone watches.
 async function logStream(uid, when) {
   const session = await poll(`the stream report of ${uid}`, 5000, 250, async () => {
@@ -80,7 +80,8 @@ async function logStream(uid, when) {
     return live && live.codec ? live : null;
   }).catch(() => null);
   log(`stream of ${uid} ${when} (${env.browser}): ` + (session
-    ? `codec ${session.codec}, ${session.fps} updates/s, round trip ${session.rtt_ms} ms`
+    ? `codec ${session.codec}, quality ${session.quality ?? 'none'}, ${session.fps} updates/s, ` +
+      `round trip ${session.rtt_ms} ms`
     : 'not reported within 5 s'));
 }
 
@@ -466,9 +467,6 @@ async function main() {
   const left = [...sessionProcs.values()].filter(stillThere);
   check(left.length === 0, `session processes outlived sim_manager: ${left.map((p) => p.pid).join(', ')}`);
   log('sim_manager exited 0 and left no session process');
-  if (driver.name === 'firefox') {
-    await logAutoCodecStream(env, driver, browser, artifact('auto_codec.json'));
-  }
   await Promise.all([pageLog.close(), surveyLog.close(), strangerLog.close(), adminLog.close()]);
 }
 
