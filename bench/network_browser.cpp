@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 
 #include "manager_process.hpp"
@@ -88,14 +89,15 @@ BrowserRow run_browser(SimSettings settings, const std::string& source_dir, cons
   BrowserRow row;
   row.client = client;
   row.rtt_ms = rtt;
-  test::TempDir web_root("rfbsim-bench-novnc13");
+  std::optional<test::TempDir> web_root;  // only for the stock page; outlives the simulator serving it
   if (client.page == "novnc13") {
     if (!std::filesystem::is_regular_file(std::string(kStockNoVncRoot) + "/vnc.html")) {
       row.error = "no stock noVNC at /usr/share/novnc (apt-get install novnc)";
       return row;
     }
-    copy_stock_novnc(web_root.path() / "page");
-    settings.extra_args = {"--web-root", (web_root.path() / "page").string()};
+    web_root.emplace("rfbsim-bench-novnc13");
+    copy_stock_novnc(web_root->path() / "page");
+    settings.extra_args = {"--web-root", (web_root->path() / "page").string()};
   }
   const auto started = Clock::now();
   const auto path =

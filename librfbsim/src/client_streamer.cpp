@@ -159,19 +159,19 @@ std::optional<QualityLevel> ClientStreamer::tight_quality() const {
   if (config_.jpeg_quality <= 0) return std::nullopt;
   // The top level keeps the configured subsampling, lowered to what the client asked for; the ladder below it
   // is 4:2:0 (or the client's coarser choice) and already starts at the client's quality (client_requested()).
-  const QualityLevel top = capped_by_client({config_.jpeg_quality, config_.subsampling}, request_);
+  const QualityLevel top = client_top();
   // Only pushed streams have the fences that tell a slow link apart from a slow client.
   if (!config_.adaptive_quality || !protocol_.continuous || still_refresh_ || quality_.level() == 0) return top;
   return capped_by_client(quality_.current(), request_);
 }
 
-int ClientStreamer::client_top_quality() const {
-  return capped_by_client({config_.jpeg_quality, config_.subsampling}, request_).jpeg_quality;
+QualityLevel ClientStreamer::client_top() const {
+  return capped_by_client({config_.jpeg_quality, config_.subsampling}, request_);
 }
 
 AdaptiveQualityConfig ClientStreamer::client_ladder_config() const {
   AdaptiveQualityConfig c = quality_config(config_);
-  c.top_quality = client_top_quality();
+  c.top_quality = client_top().jpeg_quality;
   return c;
 }
 
@@ -181,7 +181,7 @@ void ClientStreamer::client_requested(const ClientQualityRequest& request) {
   if (config_.jpeg_quality <= 0) return;
   // The client's quality is the top of its ladder: the ladder is rebuilt (and starts at its top) when that
   // top moves, as at a client's first SetEncodings or when TigerVNC's AutoSelect picks another level.
-  if (client_top_quality() == quality_.levels().front().jpeg_quality) return;
+  if (client_top().jpeg_quality == quality_.levels().front().jpeg_quality) return;
   quality_ = AdaptiveQuality(client_ladder_config());
 }
 

@@ -83,8 +83,9 @@ class ClientStreamer {
   void ping(_rfbClientRec* client, TimePoint now);
   void offer_frame(TimePoint now, bool held);
   void count_update(TimePoint now);
-  // The top JPEG quality for this client (the server's, lowered to what it asked for), and its ladder's tuning.
-  [[nodiscard]] int client_top_quality() const;
+  // The top level for this client (the server's quality and subsampling, lowered to what it asked for), and its
+  // ladder's tuning.
+  [[nodiscard]] QualityLevel client_top() const;
   [[nodiscard]] AdaptiveQualityConfig client_ladder_config() const;
 
   StreamerConfig config_;

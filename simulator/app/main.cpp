@@ -180,14 +180,10 @@ int run(const rfbsim::sim::SimOptions& options) {
 
   StatusBoard status;
   ClientChanges client_changes;
-  rfbsim::Server server(server_options_of(options, {options.width, options.height, options.fps}, status,
-                                          client_changes, address_key));
+  const sim::Picture picture{options.width, options.height, options.fps};
+  rfbsim::Server server(server_options_of(options, picture, status, client_changes, address_key));
 
-  rfbsim::OffscreenGLOptions gl_options;
-  gl_options.width = options.width;
-  gl_options.height = options.height;
-  gl_options.platform = options.egl_platform;
-  rfbsim::OffscreenGL gl(gl_options);
+  rfbsim::OffscreenGL gl(gl_options_of(options, picture));
   rfbsim::log::info("sim_rfb", "rendering with %s", gl.renderer().c_str());
   rfbsim::log::info("sim_rfb", "picture encoding %s, %d frames per second while watched", options.codec.c_str(),
                     options.fps);

@@ -74,11 +74,7 @@ int run_replay(const SimOptions& options, const std::atomic<bool>& stop) {
   server_options.view_only = true;
   rfbsim::Server server(std::move(server_options));
 
-  rfbsim::OffscreenGLOptions gl_options;
-  gl_options.width = picture.width;
-  gl_options.height = picture.height;
-  gl_options.platform = options.egl_platform;
-  rfbsim::OffscreenGL gl(gl_options);
+  rfbsim::OffscreenGL gl(gl_options_of(options, picture));
   rfbsim::log::info("sim_rfb", "rendering with %s", gl.renderer().c_str());
 
   FixedStepClock clock(std::chrono::nanoseconds(1'000'000'000LL / meta.tick_hz));

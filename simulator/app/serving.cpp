@@ -114,4 +114,12 @@ void StreamReporter::write(const std::string& line) {
   rfbsim::log::warn("sim_rfb", "cannot report the stream to the parent: %s; no more stream lines", error.c_str());
 }
 
+rfbsim::OffscreenGLOptions gl_options_of(const SimOptions& options, Picture picture) {
+  rfbsim::OffscreenGLOptions gl;
+  gl.width = picture.width;
+  gl.height = picture.height;
+  gl.platform = options.egl_platform;
+  return gl;
+}
+
 }  // namespace rfbsim::sim

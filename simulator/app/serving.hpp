@@ -12,6 +12,7 @@
 
 #include "app/options.hpp"
 #include "contract/ready_line.hpp"
+#include "rfbsim/offscreen_gl.hpp"
 #include "rfbsim/server.hpp"
 
 namespace rfbsim::sim {
@@ -98,5 +99,8 @@ struct Picture {
 /// three must outlive the server. Throws std::runtime_error when no participant page is found.
 rfbsim::ServerOptions server_options_of(const SimOptions& options, Picture picture, const StatusBoard& status,
                                         ClientChanges& client_changes, const std::string& address_key);
+
+/// The off-screen renderer for `picture`, on the EGL platform the command line asks for.
+rfbsim::OffscreenGLOptions gl_options_of(const SimOptions& options, Picture picture);
 
 }  // namespace rfbsim::sim
