@@ -100,6 +100,7 @@ state.watching = watching;
 
 // The survey around this page (if any) hears how the session goes; a researcher's watching page tells no one.
 export const survey = new SurveyReporter(watching ? null : window.parent, window);
-state.outcome = null;          // 'completed' | 'timeout' once the task has an outcome (from sim_manager)
+state.outcome = null;          // 'completed' | 'timeout' | 'watched' once the task has an outcome (from sim_manager)
+state.watcher = false;         // a video-condition session (sim_manager's status): the participant only watches
 state.completionCode = null;   // the code the link carried for that outcome
 state.surveyEvents = survey.sent;  // the events posted to the survey so far (a Set, for tests)

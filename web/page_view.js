@@ -51,8 +51,9 @@ export function showProgress() {
 // itself not focused).
 export function updateFocus() {
   state.focused = page.canvas !== null && document.hasFocus() && document.activeElement === page.canvas;
-  // After the outcome the hint would cover the completion code drawn in the picture.
-  ui.hint.hidden = watching || !state.connected || state.focused || state.outcome !== null;
+  // After the outcome the hint would cover the completion code drawn in the picture; a video-condition
+  // participant only watches, and an offer of the keyboard would mislead them.
+  ui.hint.hidden = watching || state.watcher || !state.connected || state.focused || state.outcome !== null;
 }
 
 // The notice while the page reconnects by itself: it leaves the (held) picture visible and asks for nothing, and

@@ -77,7 +77,13 @@ export async function fetchSessionStatus() {
     elapsedS: Number.isFinite(body.elapsed_s) ? body.elapsed_s : null,
   };
   state.sessionState = status.state;
-  if ((body.outcome === 'completed' || body.outcome === 'timeout') && state.outcome === null) {
+  // A video-condition session: its participant watches a recording, and their keys do nothing.
+  if (body.condition === 'video' && !state.watcher) {
+    state.watcher = true;
+    updateFocus();
+  }
+  if ((body.outcome === 'completed' || body.outcome === 'timeout' || body.outcome === 'watched') &&
+      state.outcome === null) {
     state.outcome = body.outcome;
     state.completionCode = typeof body.code === 'string' ? body.code : null;
     updateFocus();

@@ -1,10 +1,14 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // Tells a survey that embeds this page (in an iframe) how the session goes: postMessage to the parent window of
-// {type: "rfbsim", event: "started" | "completed" | "timeout" | "ended", uid, code}, each event once, and only to
-// the survey origins sim_manager is configured with (its status says which). postMessage with a target origin
+// {type: "rfbsim", event: "started" | "completed" | "timeout" | "watched" | "ended", uid, code, outcome}, each event
+// once, and only to the survey origins sim_manager is configured with (its status says which). "watched": a
+// video-condition participant was shown their recording to its end (`code` is the link's t1). `outcome` is the
+// session's outcome so far (null before it has one); sim_manager's own page for a video link with no recording
+// free sends event "unavailable" then "ended" with outcome "unavailable" (manager/http/pages.hpp). postMessage with a target origin
 // is delivered only if the parent's origin is that one, so a page framed by anyone else hears nothing.
 
-export const SURVEY_EVENTS = ['started', 'completed', 'timeout', 'ended'];
+export const SURVEY_EVENTS = ['started', 'completed', 'timeout', 'watched', 'ended'];
+const OUTCOMES = ['completed', 'timeout', 'watched'];
 
 export class SurveyReporter {
   // `target`: the window told (the parent); `self`: this page's window. Not framed (target === self): silent.
@@ -32,7 +36,7 @@ export class SurveyReporter {
       this.origins = status.survey_origins.filter((origin) => typeof origin === 'string' && origin !== '');
     }
     this.known = this.uid !== null;
-    if (status.outcome === 'completed' || status.outcome === 'timeout') {
+    if (OUTCOMES.includes(status.outcome)) {
       this.outcome = status.outcome;
       this.code = typeof status.code === 'string' ? status.code : null;
       this.post(status.outcome);
@@ -59,7 +63,7 @@ export class SurveyReporter {
     // A survey hears 'started' before an outcome, whatever came first here: an outcome can be polled before
     // the first picture shows (a task done at once, or a hidden tab that draws nothing). A session that
     // never showed a picture and ended without an outcome (it failed to start) sends 'ended' alone.
-    if ((event === 'completed' || event === 'timeout') && !this.sent.has('started')) {
+    if (OUTCOMES.includes(event) && !this.sent.has('started')) {
       this.post('started');
     }
     if (!this.known) {
@@ -71,7 +75,8 @@ export class SurveyReporter {
     this.sent.add(event);
     // 'ended' carries the outcome's code too, so that a survey listening only for it still gets the code.
     const code = event === 'started' ? null : this.code;
-    const message = { type: 'rfbsim', event, uid: this.uid, code };
+    const outcome = event === 'started' ? null : this.outcome;
+    const message = { type: 'rfbsim', event, uid: this.uid, code, outcome };
     for (const origin of this.origins) {
       try {
         this.target.postMessage(message, origin);

@@ -48,6 +48,12 @@ Json session_object(const Session& s, bool include_token) {
   json["params"] = params.is_discarded() ? Json::object() : params;
   json["ros_namespace"] = text_or_null(s.ros_namespace);
   json["robot_control"] = text_or_null(s.robot_control);
+  // The study's condition: a watcher names the session shown (by id and the keyed hash of its uid); an
+  // interactive session counts the watchers holding a place with it.
+  json["condition"] = s.condition;
+  json["yoked_to"] = s.yoked_to > 0 ? Json(s.yoked_to) : Json(nullptr);
+  json["yoked_to_uid_hash"] = text_or_null(s.yoked_to_uid_hash);
+  json["watchers"] = s.watchers;
   // The stream as sim_rfb last told it; null for what it did not say and when nobody watches.
   const bool watched = s.stream && s.stream->clients > 0;
   json["codec"] = watched ? text_or_null(s.stream->codec) : Json(nullptr);

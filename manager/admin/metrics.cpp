@@ -13,7 +13,7 @@ constexpr Rejection kAllRejections[] = {
     Rejection::kCompleted,      Rejection::kUnknownSession, Rejection::kEndedSession,
     Rejection::kForbiddenOrigin, Rejection::kUnauthorized, Rejection::kStartFailed,
     Rejection::kRateLimited,    Rejection::kConnectionLimit, Rejection::kUnspentLimit,
-    Rejection::kHead,           Rejection::kCannotRecord};
+    Rejection::kHead,           Rejection::kCannotRecord,   Rejection::kNoRecording};
 
 std::string number(double value) {
   char text[32];
@@ -61,6 +61,7 @@ const char* rejection_name(Rejection reason) {
     case Rejection::kUnspentLimit: return "unspent_limit";
     case Rejection::kHead: return "head_preview";
     case Rejection::kCannotRecord: return "cannot_record";
+    case Rejection::kNoRecording: return "no_recording";
   }
   return "other";
 }

@@ -29,6 +29,7 @@ enum class Rejection {
   kUnspentLimit,    ///< an address that started too many sessions nobody has seen yet (429)
   kHead,            ///< a HEAD (link preview) of /start: answered, nothing started
   kCannotRecord,    ///< the session index cannot take a new session's row (a full disk): nothing started
+  kNoRecording,     ///< a video-condition link found no recording it may show (503)
 };
 
 const char* rejection_name(Rejection reason);

@@ -60,6 +60,17 @@ StartDecision StartAdmission::decide(const std::string& query, const std::string
                           "(allow_camera_param is off)");
     }
   }
+  // The video condition replays sim_rfb's recordings; a pinned source is the researcher's choice, so only a
+  // signed link may make it (a participant editing an unsigned link could pick whom they watch).
+  if (parsed.request->condition == "video" && config_.session_kind != SessionKind::kSimRfb) {
+    return invalid_link(400, Rejection::kBadRequest,
+                        "condition video is not offered here: only sim_rfb sessions are recorded to be replayed");
+  }
+  if (!parsed.request->yoke_uid.empty() && config_.link_secret.empty()) {
+    return invalid_link(400, Rejection::kBadRequest,
+                        "yoke_uid is offered only on signed links (link_secret), so that a participant cannot choose "
+                        "whom they watch");
+  }
   // A link published in the open can be given an end: exp, a Unix time, signed with the rest.
   if (config_.require_link_expiry && !parsed.request->expires_at) {
     return invalid_link(403, Rejection::kBadSignature,

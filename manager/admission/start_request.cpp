@@ -138,6 +138,18 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
         out.error = "exp '" + shown(value) + "' is not valid: use a Unix time in whole seconds";
         return out;
       }
+    } else if (name == "condition") {
+      if (value != "interactive" && value != "video") {
+        out.error = "condition '" + shown(value) + "' is not valid: use interactive or video";
+        return out;
+      }
+      request.condition = value;
+    } else if (name == "yoke_uid") {
+      if (!is_identifier(value)) {
+        out.error = "yoke_uid '" + shown(value) + "' is not valid: use 1 to 64 letters, digits, '-' or '_'";
+        return out;
+      }
+      request.yoke_uid = value;
     } else if (name == "seed") {
       request.seed = strict_seed(value);
       if (!request.seed) {
@@ -179,6 +191,20 @@ StartParse parse_start_request(const QueryParams& params, const std::vector<std:
   if (!have_uid) {
     out.error = "the link has no uid (participant id)";
     return out;
+  }
+  if (request.condition != "video" && !request.yoke_uid.empty()) {
+    out.error = "yoke_uid is for condition=video links only";
+    return out;
+  }
+  // A watcher is shown the recorded session as it was: its seed, poses, crowd, robot and view are the walker's.
+  if (request.condition == "video") {
+    for (const auto& [name, value] : params) {
+      const bool sets_world = name == "seed" || std::any_of(kOverrideParams.begin(), kOverrideParams.end(),
+                                                            [&name = name](const OverrideParam& p) { return name == p.name; });
+      if (!sets_world) continue;
+      out.error = name + " is not valid with condition=video: the watcher is shown the recorded session as it was";
+      return out;
+    }
   }
   // Without a list (a program's session kind that names none) a session has no scenario.
   if (!have_scenario && !scenarios.empty()) request.scenario = scenarios.front();

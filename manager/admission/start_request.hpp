@@ -33,6 +33,12 @@ struct StartRequest {
   /// `exp`: the link is valid until this Unix time, seconds (signed with the rest when links are signed);
   /// unset = no expiry.
   std::optional<std::uint64_t> expires_at;
+  /// `condition`: "interactive" (the default: the participant walks) or "video" (they watch a replay of a
+  /// finished interactive session of the scenario, sessions/yoking.hpp).
+  std::string condition = "interactive";
+  /// `yoke_uid`: with condition=video on a signed link, the walker whose session is shown; "" = the manager
+  /// chooses (yoke_policy).
+  std::string yoke_uid;
 };
 
 /// The link parameters that override the scenario, with the sim_rfb flag each becomes: the poses, crowd (0..500)
@@ -56,7 +62,9 @@ using contract::is_identifier;
 /// A pose: a spawn point's name (an identifier) or "x,y,yaw" in metres and radians, strictly decimal.
 bool is_pose(std::string_view text);
 
-/// Validates the parameters of /start (`sig` is checked elsewhere and ignored here). `scenarios` are the
+/// Validates the parameters of /start (`sig` is checked elsewhere and ignored here). A video link
+/// (condition=video) shows a recording as it was: seed and the scenario overrides are refused with it, and
+/// yoke_uid is refused without it. `scenarios` are the
 /// allowed names; an absent scenario means the first. An empty list offers none (session kinds rfb and x11 without
 /// scenarios): the scenario is "" and a link that names one is refused. Unknown parameters are refused.
 StartParse parse_start_request(const QueryParams& params, const std::vector<std::string>& scenarios);

@@ -130,6 +130,11 @@ struct ManagerConfig {
   bool require_link_expiry = false;          ///< with a link secret: links must carry exp (a Unix time, seconds)
   bool allow_repeat = false;                 ///< a uid whose session ended may start another
   bool allow_camera_param = true;            ///< links may choose the view (camera=third_person|first_person)
+  /// The video condition (issue 33, sessions/yoking.hpp): how many watchers one interactive session may have,
+  /// and how a watcher's source is chosen: "earliest_ended" (each link: the earliest-ended source session of its
+  /// scenario with room) or "by_participant" (all of a watcher's links: the same walker's sessions).
+  int yoke_max_viewers = 1;
+  std::string yoke_policy = "earliest_ended";
   std::string host_id;                       ///< recorded in the index; empty = this machine's host name
   std::string web_root;                      ///< participant page; empty = the built or installed one
   /// This host's own public origin (e.g. https://h2.study.example.org); when set, /start redirects there,

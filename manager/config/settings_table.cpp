@@ -240,6 +240,13 @@ std::vector<Setting> build_table() {
       row("allow_repeat", boolean(&ManagerConfig::allow_repeat), "a uid whose session ended may start another"),
       row("allow_camera_param", boolean(&ManagerConfig::allow_camera_param),
           "links may choose the participant's view with `camera`; off, such a link is refused (400)"),
+      row("yoke_max_viewers", integer(&ManagerConfig::yoke_max_viewers, 1, 1000),
+          "the video condition (`condition=video` links): how many watchers one interactive session may have "
+          "(with `by_participant`, also how many watchers one walker may be paired with)"),
+      row("yoke_policy", choice(&ManagerConfig::yoke_policy, {"earliest_ended", "by_participant"}),
+          "how a watcher's source session is chosen: `earliest_ended` (per link, the earliest-ended spent "
+          "session of the link's scenario with room) or `by_participant` (every link of a watcher shows the same "
+          "walker, paired at the watcher's first link; see docs/study-guide.md)"),
       row("host_id",
           checked_text(&ManagerConfig::host_id, "ID", "",
                        [](const std::string& value) -> std::string {

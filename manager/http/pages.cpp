@@ -69,6 +69,40 @@ std::string session_ended_page(std::string_view state) {
                     "). Please go back to the survey.</p>");
 }
 
+namespace {
+
+// Text as a JavaScript string literal inside a <script>: JSON-escaped, and '<' written as \u003c so that no
+// "</script>" can end the element early.
+std::string script_string(std::string_view text) {
+  std::string out = "\"";
+  for (const char ch : json_escape(text)) {
+    if (ch == '<') {
+      out += "\\u003c";
+    } else {
+      out.push_back(ch);
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+std::string recording_unavailable_page(std::string_view uid, const std::vector<std::string>& survey_origins) {
+  std::string origins;
+  for (const std::string& origin : survey_origins) origins += (origins.empty() ? "" : ",") + script_string(origin);
+  // Inline: this page has no files of its own to load, and the manager's pages restrict only their framing.
+  const std::string script =
+      "<script>\n(function () {\n  if (window.parent === window) return;\n  var origins = [" + origins +
+      "];\n  ['unavailable', 'ended'].forEach(function (event) {\n    var message = {type: 'rfbsim', event: event, "
+      "uid: " + script_string(uid) + ", code: null, outcome: 'unavailable'};\n    origins.forEach(function (origin) "
+      "{\n      try { window.parent.postMessage(message, origin); } catch (err) { /* a malformed origin */ }\n    "
+      "});\n  });\n})();\n</script>";
+  return layout("No recording to watch right now",
+                "<p>This part of the study shows a recording of an earlier session, and none is free for you at the "
+                "moment. Please go back to the survey, or tell the researcher.</p>\n<p><small>Error 503</small></p>\n" +
+                    script);
+}
+
 std::string error_page(int status, std::string_view title, std::string_view message) {
   return layout(title, "<p>" + html_escape(message) + "</p>\n<p><small>Error " + std::to_string(status) +
                            "</small></p>");

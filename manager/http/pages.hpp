@@ -5,6 +5,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace rfbsim::manager {
 
@@ -27,6 +28,12 @@ std::string completed_page();
 
 /// The session behind a link has ended (`state` in words, e.g. "expired").
 std::string session_ended_page(std::string_view state);
+
+/// A video-condition link with no recording free to show (503). Inside a survey's frame the page tells the
+/// survey, as the participant's page does an outcome: {type: "rfbsim", event, uid, code: null, outcome:
+/// "unavailable"}, event "unavailable" then "ended", posted to the parent only at `survey_origins` (the
+/// manager's frame_origins), so that a page framed by anyone else hears nothing.
+std::string recording_unavailable_page(std::string_view uid, const std::vector<std::string>& survey_origins);
 
 /// Any other refusal: a title and a message (escaped here).
 std::string error_page(int status, std::string_view title, std::string_view message);

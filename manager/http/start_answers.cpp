@@ -63,6 +63,10 @@ PageAnswer answer_start_outcome(const StartOutcome& outcome, const ManagerConfig
                              "The study's server cannot save new sessions at the moment. Please try the link again in "
                              "a few minutes, or tell the researcher."),
                   retry_after(kCannotRecordRetrySeconds), Rejection::kCannotRecord);
+    case StartOutcome::Kind::kNoRecording:
+      // No Retry-After and no reload: a recording frees up only when another watcher's session fails, and the
+      // survey is told at once (outcome unavailable) so that it can go on.
+      return page(503, recording_unavailable_page(outcome.uid, config.frame_origins), {}, Rejection::kNoRecording);
     case StartOutcome::Kind::kFailed: break;
   }
   return page(503, error_page(503, "The simulation could not start",

@@ -61,11 +61,7 @@ void IndexWriter::run() {
 std::string record_session(SessionIndex& index, const Session& session, bool insert) {
   std::string error;
   try {
-    if (insert) {
-      index.insert(session);
-    } else {
-      index.write(session);  // the row too, where its insert had failed
-    }
+    index.record(session, insert);  // an update writes the row too, where its insert had failed
   } catch (const std::exception& failure) {
     error = std::string("cannot write the index: ") + failure.what();
   }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "contract/replay_flags.hpp"
 #include "sessions/session_process.hpp"
 #include "http/web_policy.hpp"
 
@@ -49,6 +50,38 @@ std::vector<std::string> expand_template(const ManagerConfig& config, const Star
   }
   std::vector<std::string> args;
   for (const std::string& arg : config.session_args) args.push_back(expand(arg, values));
+  return args;
+}
+
+// config.session_args less the flags that make a world (contract::kWorldFlags), each with its value: what a
+// watcher's sim_rfb --replay is given of them.
+std::vector<std::string> without_world_flags(const std::vector<std::string>& session_args) {
+  std::vector<std::string> kept;
+  for (std::size_t i = 0; i < session_args.size(); ++i) {
+    const std::string& arg = session_args[i];
+    const std::string flag = arg.substr(0, arg.find('='));
+    if (std::find(contract::kWorldFlags.begin(), contract::kWorldFlags.end(), flag) == contract::kWorldFlags.end()) {
+      kept.push_back(arg);
+    } else if (flag == arg) {
+      ++i;  // --flag VALUE: the value goes too
+    }
+  }
+  return kept;
+}
+
+// The end of every sim_rfb session's command line: where its data goes and for whom, how it streams, its codes.
+std::vector<std::string> with_session_record(const ManagerConfig& config, const StartRequest& request,
+                                             const LaunchContext& context, std::vector<std::string> args) {
+  // Session data goes to the session's folder; the codes are shown in the picture when the task ends. The
+  // relay names each browser's address in a PROXY line, which sim_rfb records hashed.
+  args.insert(args.end(), {"--proxy-protocol", "--data-dir", context.data_dir, "--uid", request.uid});
+  // The picture encoding, always named, so that the session's command line says what it ran with.
+  args.insert(args.end(), {"--codec", config.codec});
+  if (!request.code_success.empty()) args.insert(args.end(), {"--code-success", request.code_success});
+  // A watcher cannot run out of time: their code is t1, shown and sent when the recording has been shown.
+  if (!request.code_timeout.empty() && context.replay_source.empty()) {
+    args.insert(args.end(), {"--code-timeout", request.code_timeout});
+  }
   return args;
 }
 
@@ -125,7 +158,8 @@ SessionRos session_ros(const ManagerConfig& config, const StartRequest& request,
 }
 
 std::string ros_request_problem(const ManagerConfig& config, const StartRequest& request) {
-  if (config.session_kind != SessionKind::kSimRfb) return "";
+  // A watcher's session replays the robot as it was recorded: nothing drives it.
+  if (config.session_kind != SessionKind::kSimRfb || request.condition == "video") return "";
   const SessionRos ros = session_ros(config, request, 0);
   const bool asked = std::any_of(request.overrides.begin(), request.overrides.end(), [](const auto& override_) {
     return override_.first == "robot_control" && override_.second == "external";
@@ -160,15 +194,21 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
   }
   // The config's extra arguments first: sim_rfb takes the last of a repeated flag, so everything the
   // manager and the link set below wins, whatever the config holds.
-  std::vector<std::string> args = config.session_args;
+  const bool replay = !context.replay_source.empty();
+  std::vector<std::string> args = replay ? without_world_flags(config.session_args) : config.session_args;
   // A unix socket only the manager's user can open: another local user cannot reach a participant's session.
   if (context.unix_socket.empty()) {
     args.insert(args.end(), {"--port", "0", "--bind", "127.0.0.1"});
   } else {
     args.insert(args.end(), {"--unix-socket", context.unix_socket});
   }
-  args.insert(args.end(), {"--rfb-only", "--ready-fd", std::to_string(kReadyFd), "--scenario", scenario, "--seed",
-                           std::to_string(context.seed)});
+  args.insert(args.end(), {"--rfb-only", "--ready-fd", std::to_string(kReadyFd)});
+  if (replay) {
+    // A watcher's session: the recording's world as it was (its scenario, seed, poses, robot), view-only.
+    args.insert(args.end(), {"--replay", context.replay_source, "--yoked-to", std::to_string(context.yoked_to)});
+    return with_session_record(config, request, context, std::move(args));
+  }
+  args.insert(args.end(), {"--scenario", scenario, "--seed", std::to_string(context.seed)});
   for (const auto& [name, value] : request.overrides) {
     const auto param = std::find_if(kOverrideParams.begin(), kOverrideParams.end(),
                                     [&name = name](const OverrideParam& p) { return name == p.name; });
@@ -187,14 +227,7 @@ std::vector<std::string> session_arguments(const ManagerConfig& config, const St
     if (!config.ros.token_file.empty()) args.insert(args.end(), {"--rosbridge-token-file", config.ros.token_file});
     if (!config.ros.ca_file.empty()) args.insert(args.end(), {"--rosbridge-ca", config.ros.ca_file});
   }
-  // Session data goes to the session's folder; the codes are shown in the picture when the task ends. The
-  // relay names each browser's address in a PROXY line, which sim_rfb records hashed.
-  args.insert(args.end(), {"--proxy-protocol", "--data-dir", context.data_dir, "--uid", request.uid});
-  // The picture encoding, always named, so that the session's command line says what it ran with.
-  args.insert(args.end(), {"--codec", config.codec});
-  if (!request.code_success.empty()) args.insert(args.end(), {"--code-success", request.code_success});
-  if (!request.code_timeout.empty()) args.insert(args.end(), {"--code-timeout", request.code_timeout});
-  return args;
+  return with_session_record(config, request, context, std::move(args));
 }
 
 std::string parameters_json(const StartRequest& request, std::uint64_t seed) {
@@ -205,6 +238,9 @@ std::string parameters_json(const StartRequest& request, std::uint64_t seed) {
   }
   if (!request.code_success.empty()) json += ",\"t1\":\"" + json_escape(request.code_success) + "\"";
   if (!request.code_timeout.empty()) json += ",\"t2\":\"" + json_escape(request.code_timeout) + "\"";
+  // A video link's condition; its yoke_uid is left out: a watcher's records never name the walker's uid.
+  if (request.condition != "interactive") json += ",\"condition\":\"" + json_escape(request.condition) + "\"";
+  if (!request.yoke_uid.empty()) json += ",\"yoke_pinned\":true";
   return json + "}";
 }
 

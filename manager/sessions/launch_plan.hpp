@@ -25,6 +25,10 @@ struct LaunchContext {
   /// kX11: the session's Xauthority file, written fresh by rfbsim_x11_session (beside unix_socket, where only
   /// the manager's user can read it).
   std::string xauthority{};
+  /// A video-condition session (kSimRfb): the folder of the session it shows and that session's id; "" = a
+  /// live session.
+  std::string replay_source{};
+  std::int64_t yoked_to = 0;
 };
 
 /// What a session is told of ROS (the config's `ros:` section and the link's robot_control).
@@ -54,6 +58,9 @@ std::string ros_request_problem(const ManagerConfig& config, const StartRequest&
 ///    --codec C (config.codec), --code-success T1 and --code-timeout T2 when the link has them. sim_rfb takes
 ///    the last of a repeated flag, so the manager's and the link's win over the config's (which
 ///    session_args_problem refuses for the manager's flags anyway).
+///    A video-condition session (context.replay_source) gets instead of --scenario, --seed, the overrides and
+///    ROS: --replay DIR --yoked-to ID, and config.session_args less contract::kWorldFlags and their values (a
+///    walker's --time-limit must not make the watcher's sim_rfb refuse to start).
 ///  - kRfb: config.session_args with {port}, {scenario}, {seed}, {uid}, {data_dir}, {t1}, {t2} and one
 ///    placeholder per override, {avatar_start} {avatar_goal} {robot_start} {robot_goal} {crowd} {robot_control},
 ///    replaced;

@@ -107,6 +107,14 @@ struct Session {
   /// launch_plan's session_ros. For the researcher only: never on a participant's page.
   std::string ros_namespace;
   std::string robot_control;
+  /// The study's condition (issue 33): "interactive" (walked) or "video" (watched a replay of `yoked_to`, the
+  /// id of an interactive session of this host, whose uid's keyed hash is `yoked_to_uid_hash`; never its uid).
+  std::string condition = "interactive";
+  std::int64_t yoked_to = 0;
+  std::string yoked_to_uid_hash;
+  /// Interactive sessions: how many video sessions hold their place as its watchers (the index counts them as
+  /// it writes a watcher's row; read from the index, never written from here).
+  int watchers = 0;
   /// The participant's stream as sim_rfb last reported it while someone watched; unset before the first report,
   /// when nobody watches, and for sessions read from the index (it is not stored there).
   std::optional<StreamReport> stream;

@@ -43,7 +43,11 @@ CREATE TABLE IF NOT EXISTS sessions (
   copy_error    TEXT NOT NULL DEFAULT '',  -- its last failure ("exit 23: ..."); '' when done
   address_hash  TEXT NOT NULL DEFAULT '',  -- keyed hash of the participant's address (as in events.jsonl)
   ros_namespace TEXT NOT NULL DEFAULT '',  -- its topics under the lab's ROS ("/rfbsim/s_12"); '' = no ROS
-  robot_control TEXT NOT NULL DEFAULT ''   -- who drove the robot: builtin, external; '' = no robot known
+  robot_control TEXT NOT NULL DEFAULT '',  -- who drove the robot: builtin, external; '' = no robot known
+  condition     TEXT NOT NULL DEFAULT 'interactive',  -- interactive, or video (a watcher of a replay)
+  yoked_to      INTEGER,                -- video: the id of the session shown (on this host); NULL otherwise
+  yoked_to_uid_hash TEXT NOT NULL DEFAULT '',  -- video: keyed hash of that session's uid (never the uid)
+  watchers      INTEGER NOT NULL DEFAULT 0     -- interactive: the video sessions shown it that hold their place
 );
 CREATE INDEX IF NOT EXISTS sessions_by_uid ON sessions (uid, id);
 CREATE INDEX IF NOT EXISTS sessions_by_state ON sessions (state);
@@ -66,7 +70,12 @@ CREATE TABLE IF NOT EXISTS uid_acceptors (
 constexpr const char* kColumns =
     "id, uid, token, scenario, params, seed, host_id, state, detail, exit_status, pid, process_start, port, "
     "data_path, created_at, ready_at, ended_at, outcome, code_success, code_timeout, spent_at, data_incomplete, "
-    "copy_state, copy_attempts, copy_error, address_hash, ros_namespace, robot_control";
+    "copy_state, copy_attempts, copy_error, address_hash, ros_namespace, robot_control, condition, yoked_to, "
+    "yoked_to_uid_hash, watchers";
+
+// The states in which a watcher holds its place with its source (sessions/yoking.hpp): live, or ran its
+// course. A watcher that failed, crashed, was interrupted or shut down, or never showed a picture, frees it.
+constexpr const char* kHoldingStates = "('starting', 'running', 'ending', 'finished', 'expired', 'idle', 'ended')";
 
 // One prepared statement, finalized on scope exit.
 class Statement {
@@ -141,6 +150,10 @@ Session read_row(Statement& row) {
   s.address_hash = row.text(25);
   s.ros_namespace = row.text(26);
   s.robot_control = row.text(27);
+  s.condition = row.text(28);
+  s.yoked_to = row.is_null(29) ? 0 : row.integer(29);
+  s.yoked_to_uid_hash = row.text(30);
+  s.watchers = static_cast<int>(row.integer(31));
   return s;
 }
 
@@ -212,6 +225,7 @@ void SessionIndex::add_missing_columns() {
   bool has_address_hash = false;
   bool has_ros_namespace = false;
   bool has_robot_control = false;
+  bool has_condition = false;
   {
     Statement columns(db_, "PRAGMA table_info(sessions)");
     while (columns.step()) {
@@ -221,6 +235,7 @@ void SessionIndex::add_missing_columns() {
       has_address_hash = has_address_hash || columns.text(1) == "address_hash";
       has_ros_namespace = has_ros_namespace || columns.text(1) == "ros_namespace";
       has_robot_control = has_robot_control || columns.text(1) == "robot_control";
+      has_condition = has_condition || columns.text(1) == "condition";
     }
   }
   if (!has_codes) {
@@ -242,6 +257,21 @@ void SessionIndex::add_missing_columns() {
   // between the two leaves nothing half-done for the next start.
   if (!has_ros_namespace) exec("ALTER TABLE sessions ADD COLUMN ros_namespace TEXT NOT NULL DEFAULT ''");
   if (!has_robot_control) exec("ALTER TABLE sessions ADD COLUMN robot_control TEXT NOT NULL DEFAULT ''");
+  // Sessions recorded before the video condition were all interactive. One transaction: all four or none.
+  if (!has_condition) {
+    exec("BEGIN IMMEDIATE");
+    try {
+      exec("ALTER TABLE sessions ADD COLUMN condition TEXT NOT NULL DEFAULT 'interactive'");
+      exec("ALTER TABLE sessions ADD COLUMN yoked_to INTEGER");
+      exec("ALTER TABLE sessions ADD COLUMN yoked_to_uid_hash TEXT NOT NULL DEFAULT ''");
+      exec("ALTER TABLE sessions ADD COLUMN watchers INTEGER NOT NULL DEFAULT 0");
+      exec("COMMIT");
+    } catch (...) {
+      sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+      throw;
+    }
+  }
+  exec("CREATE INDEX IF NOT EXISTS sessions_by_source ON sessions (yoked_to)");
 }
 
 void SessionIndex::exec(const char* sql) {
@@ -257,7 +287,8 @@ std::int64_t SessionIndex::insert(const Session& s) {
   Statement insert(db_,
                    "INSERT INTO sessions (uid, token, scenario, params, seed, host_id, state, detail, pid, "
                    "process_start, port, data_path, created_at, code_success, code_timeout, spent_at, address_hash, "
-                   "ros_namespace, robot_control, id) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
+                   "ros_namespace, robot_control, condition, yoked_to, yoked_to_uid_hash, id) "
+                   "VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
   insert.bind(1, s.uid);
   insert.bind(2, s.token);
   insert.bind(3, s.scenario);
@@ -277,10 +308,17 @@ std::int64_t SessionIndex::insert(const Session& s) {
   insert.bind(17, s.address_hash);
   insert.bind(18, s.ros_namespace);
   insert.bind(19, s.robot_control);
-  if (s.id > 0) {
-    insert.bind(20, s.id);
+  insert.bind(20, s.condition);
+  if (s.yoked_to > 0) {
+    insert.bind(21, s.yoked_to);
   } else {
-    insert.bind_null(20);  // SQLite picks the next id
+    insert.bind_null(21);
+  }
+  insert.bind(22, s.yoked_to_uid_hash);
+  if (s.id > 0) {
+    insert.bind(23, s.id);
+  } else {
+    insert.bind_null(23);  // SQLite picks the next id
   }
   insert.step();
   return sqlite3_last_insert_rowid(db_);
@@ -344,6 +382,35 @@ void SessionIndex::write(const Session& s) {
   } else {
     insert(s);
   }
+}
+
+void SessionIndex::record(const Session& s, bool is_new) {
+  if (s.yoked_to <= 0) {
+    is_new ? static_cast<void>(insert(s)) : write(s);
+    return;
+  }
+  // A watcher's row and its source's count change together: a crash between them cannot leave a count that
+  // disagrees with the rows (the count is what the researcher reads; the choice counts the rows themselves).
+  exec("BEGIN IMMEDIATE");
+  try {
+    is_new ? static_cast<void>(insert(s)) : write(s);
+    Statement count(db_, std::string("UPDATE sessions SET watchers = (SELECT COUNT(*) FROM sessions WHERE yoked_to = ?1 "
+                                     "AND state IN ") + kHoldingStates + ") WHERE id = ?1");
+    count.bind(1, s.yoked_to);
+    count.step();
+    exec("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+}
+
+std::vector<Session> SessionIndex::yoking_rows(const std::string& host_id) {
+  // Sources that may be shown (interactive, spent, ran their course) and every watcher: the choice needs the
+  // watchers of all scenarios to know who is paired with whom (yoke_policy by_participant).
+  return query("WHERE host_id = ? AND ((condition = 'interactive' AND spent_at IS NOT NULL AND state IN "
+               "('finished', 'expired', 'idle', 'ended')) OR condition = 'video') ORDER BY id",
+               {host_id});
 }
 
 std::vector<Session> SessionIndex::query(const std::string& where, const std::vector<std::string>& binds) {

@@ -41,6 +41,12 @@ class SessionIndex {
   void update(const Session& session);
   /// update(), or insert() where the index has no row of session.id yet (its first write had failed).
   void write(const Session& session);
+  /// What the writer does with each version of a session: insert() (`is_new`) or write(), and for a watcher
+  /// (yoked_to set) its source's `watchers` counted again in the same transaction.
+  void record(const Session& session, bool is_new);
+  /// This host's sessions the video condition chooses among (sessions/yoking.hpp): interactive ones that may be
+  /// shown (spent, ran their course) and every video one, oldest first.
+  std::vector<Session> yoking_rows(const std::string& host_id);
   /// Records a session's after-session copy: its state ("pending", "done", "failed"), tries so far and last
   /// failure. Throws std::runtime_error when there is no such session.
   void set_copy_status(std::int64_t id, const std::string& state, int attempts, const std::string& error);

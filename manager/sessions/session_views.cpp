@@ -27,8 +27,8 @@ std::string status_json(const Session& session, WallTime now, const std::vector<
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.3f", std::chrono::duration<double>(now - session.created).count());
   const auto quoted = [](const std::string& text) { return text.empty() ? std::string("null") : "\"" + json_escape(text) + "\""; };
-  // A replay's watcher (outcome "watched", sim_rfb --replay) is given the success code for now: the video
-  // condition's own codes are the manager's next step (docs/replay.md).
+  // A watcher's link (condition video) carries the video condition's own code as t1: given when the recording
+  // was shown to its end (outcome "watched").
   const std::string& code = session.outcome == "completed" || session.outcome == "watched" ? session.code_success
                             : session.outcome == "timeout" ? session.code_timeout
                                                            : session.outcome;  // empty without an outcome
@@ -38,7 +38,7 @@ std::string status_json(const Session& session, WallTime now, const std::vector<
          state_name(coming_state(session)) + "\",\"elapsed_s\":" + seconds + ",\"uid\":\"" + json_escape(session.uid) +
          "\",\"outcome\":" + quoted(session.outcome) + ",\"code\":" + quoted(code) + ",\"survey_origins\":[" +
          origins + "]" + (program == "sim_rfb" ? std::string() : ",\"program\":\"" + json_escape(program) + "\"") +
-         "}";
+         (session.condition == "video" ? std::string(",\"condition\":\"video\"") : std::string()) + "}";
 }
 
 std::string session_record_json(const Session& s) {
@@ -52,7 +52,10 @@ std::string session_record_json(const Session& s) {
          "\",\"ready_at\":" + time(s.ready_at) + ",\"spent_at\":" + time(s.spent_at) + ",\"ended_at\":" +
          time(s.ended_at) + ",\"outcome\":" + text_or_null(s.outcome) +
          ",\"data_incomplete\":" + text_or_null(s.data_incomplete) + ",\"ros_namespace\":" +
-         text_or_null(s.ros_namespace) + ",\"robot_control\":" + text_or_null(s.robot_control) + "}\n";
+         text_or_null(s.ros_namespace) + ",\"robot_control\":" + text_or_null(s.robot_control) +
+         ",\"condition\":\"" + json_escape(s.condition) + "\",\"yoked_to\":" +
+         (s.yoked_to > 0 ? std::to_string(s.yoked_to) : std::string("null")) +
+         ",\"yoked_to_uid_hash\":" + text_or_null(s.yoked_to_uid_hash) + "}\n";
 }
 
 }  // namespace rfbsim::manager

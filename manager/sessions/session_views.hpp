@@ -23,15 +23,17 @@ CloseNotice close_notice(SessionState state);
 /// 3 decimals, "uid":..., "outcome": "completed" | "timeout" | null, "code": the outcome's completion code
 /// or null, "survey_origins": [...]}. The page posts the outcome to its parent window, and only to
 /// `survey_origins` (a watching researcher's page gets none). A session of another program than sim_rfb adds
-/// "program": `program` ("rfb" or "x11", session_kind_name), so that the page does not offer sim_rfb's WASD hint.
+/// "program": `program` ("rfb" or "x11", session_kind_name), so that the page does not offer sim_rfb's WASD hint;
+/// "condition": "video" (only then) tells the page that its participant watches a recording.
 std::string status_json(const Session& session, WallTime now, const std::vector<std::string>& survey_origins,
                         const std::string& program = "sim_rfb");
 
 /// The manager's record of a session, written beside the session's own data as manager.json so that the
 /// study's tools (sim_report) see how each session ended without the index: {"id", "uid", "host",
 /// "address_hash", "state", "detail", "created_at", "ready_at", "spent_at", "ended_at", "outcome",
-/// "data_incomplete", "ros_namespace", "robot_control"} (times ISO 8601 UTC or null; address_hash, outcome,
-/// data_incomplete, ros_namespace and robot_control null when there is none). address_hash is the participant's address hashed as in events.jsonl. No token, address or secret.
+/// "data_incomplete", "ros_namespace", "robot_control", "condition", "yoked_to", "yoked_to_uid_hash"} (times ISO
+/// 8601 UTC or null; address_hash, outcome, data_incomplete, ros_namespace, robot_control, yoked_to and
+/// yoked_to_uid_hash null when there is none; condition "interactive" or "video"). address_hash is the participant's address hashed as in events.jsonl. No token, address or secret.
 std::string session_record_json(const Session& session);
 
 }  // namespace rfbsim::manager

@@ -219,6 +219,31 @@ std::optional<Session> Supervisor::latest_for_uid(const std::string& uid) {
   return latest;
 }
 
+YokeChoice Supervisor::choose_source(const StartRequest& request) {
+  std::vector<Session> rows = index_.yoking_rows(config_.host_id);
+  // The newest version of each session: a watcher started a moment ago is only queued, and must count.
+  for (const auto& [id, queued] : unsaved_) {
+    const auto row = std::find_if(rows.begin(), rows.end(), [id = id](const Session& r) { return r.id == id; });
+    if (row != rows.end()) {
+      *row = queued.session;
+    } else {
+      rows.push_back(queued.session);
+    }
+  }
+  YokeRequest yoke;
+  yoke.watcher_uid = request.uid;
+  yoke.scenario = request.scenario;
+  yoke.pinned_uid = request.yoke_uid;
+  yoke.by_participant = config_.yoke_policy == "by_participant";
+  yoke.max_viewers = config_.yoke_max_viewers;
+  yoke.host_id = config_.host_id;
+  // A folder moved or deleted by hand (or by an after-session command) cannot be shown.
+  return choose_yoke_source(rows, yoke, [](const Session& source) {
+    std::error_code ec;
+    return std::filesystem::is_regular_file(std::filesystem::path(source.data_path) / "session.json", ec);
+  });
+}
+
 bool Supervisor::has_session_for_uid(const std::string& uid) {
   return table_.by_uid(uid) != nullptr || latest_for_uid(uid).has_value();
 }
@@ -429,7 +454,9 @@ std::vector<Session> Supervisor::recent(int limit) {
   for (const auto& [id, queued] : unsaved_) {
     const auto row = std::find_if(rows.begin(), rows.end(), [id = id](const Session& r) { return r.id == id; });
     if (row != rows.end()) {
+      const int watchers = row->watchers;  // the index's count: the table never keeps one
       *row = queued.session;
+      row->watchers = watchers;
     } else {
       rows.push_back(queued.session);
     }

@@ -22,6 +22,7 @@
 #include "sessions/session_copier.hpp"
 #include "sessions/session_index.hpp"
 #include "sessions/session_table.hpp"
+#include "sessions/yoking.hpp"
 #include "admission/start_request.hpp"
 
 namespace rfbsim::manager {
@@ -43,10 +44,14 @@ struct StartOutcome {
   /// kPreviousEnding: the uid's own session is still ending (seconds from gone); not kBusy, so that nobody
   /// retries on another host, where a second session of the uid would start.
   /// kCannotRecord: the index could not take the new session's row (a full disk), so nothing was started.
-  enum class Kind { kJoined, kStarted, kBusy, kCompleted, kFailed, kTooManyUnspent, kPreviousEnding, kCannotRecord } kind =
-      Kind::kFailed;
+  /// kNoRecording: a video-condition link found no session it may show (sessions/yoking.hpp; `message` says why,
+  /// for the researcher's log).
+  enum class Kind {
+    kJoined, kStarted, kBusy, kCompleted, kFailed, kTooManyUnspent, kPreviousEnding, kCannotRecord, kNoRecording
+  } kind = Kind::kFailed;
   std::string token;    ///< kJoined, kStarted
-  std::string message;  ///< kFailed: why, for the log and the page
+  std::string message;  ///< kFailed: why, for the log and the page; kNoRecording: why, for the log only
+  std::string uid;      ///< kNoRecording: the link's uid, which the page names to the survey
 };
 
 class SocketFolder;  // sessions/socket_folder.hpp
@@ -161,6 +166,9 @@ class Supervisor {
   void launch_recorded(std::int64_t id, LaunchJob job, const std::string& insert_error, StartReply reply);
   // The uid's newest session in the index or among writes still queued.
   std::optional<Session> latest_for_uid(const std::string& uid);
+  // The session a video-condition link shows (sessions/yoking.hpp), from the index with the writes still queued
+  // laid over it. Throws std::runtime_error when the index cannot be read.
+  YokeChoice choose_source(const StartRequest& request);
   std::string session_log_tail(const Session& session) const;
   // For the save that makes `session`'s folder final: marks its after-session copy 'pending' (in that same row)
   // and returns what queues the copy once the row and manager.json are written; nullptr without a copier or folder.

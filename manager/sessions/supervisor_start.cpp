@@ -23,6 +23,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "rfbsim/log.hpp"
 #include "sessions/launch_plan.hpp"
 #include "sessions/process_launcher.hpp"
 #include "record/digest.hpp"
@@ -125,11 +126,42 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
     }
   }
 
+  // A watcher's source is chosen now, on this thread, and their session enters the table and the write queue
+  // below before the next /start is looked at: two watchers at once never take one place.
+  std::optional<Session> source;
+  if (request.condition == "video") {
+    try {
+      YokeChoice choice = choose_source(request);
+      if (!choice.source) {
+        // Rate-limited: a participant can ask again and again.
+        rfbsim::log::limited(rfbsim::log::Level::kInfo, "no-recording", "manager", "uid %s: no recording to show (%s)",
+                             request.uid.c_str(), choice.why_none.c_str());
+        outcome.kind = StartOutcome::Kind::kNoRecording;
+        outcome.message = choice.why_none;
+        outcome.uid = request.uid;
+        reply(outcome);
+        return;
+      }
+      source = std::move(choice.source);
+    } catch (const std::exception& error) {
+      outcome.message = std::string("the session index cannot be read: ") + error.what();
+      reply(outcome);
+      return;
+    }
+  }
+
   Session session;
   session.uid = request.uid;
   session.token = new_session_token();
   session.scenario = request.scenario;
-  session.seed = request.seed.value_or(new_seed());
+  // A watcher's session is the recording's world: its seed is the source's (for the record; sim_rfb reads it
+  // from the recording).
+  session.seed = source ? source->seed : request.seed.value_or(new_seed());
+  if (source) {
+    session.condition = "video";
+    session.yoked_to = source->id;
+    session.yoked_to_uid_hash = sim::hash_uid(address_key(), source->uid);
+  }
   session.params_json = parameters_json(request, session.seed);
   session.code_success = request.code_success;
   session.code_timeout = request.code_timeout;
@@ -140,12 +172,18 @@ void Supervisor::start(const StartRequest& request, const std::string& address, 
   // Ids are handed out here, so that the row can be written off this thread; the participant is redirected
   // only once it is committed (below), so a redirect always points at a recorded session.
   session.id = next_id_++;
-  const SessionRos ros = session_ros(config_, request, session.id);
-  session.ros_namespace = ros.ros_namespace;
-  session.robot_control = ros.robot_control;
+  if (!source) {  // a replayed robot is driven by nobody
+    const SessionRos ros = session_ros(config_, request, session.id);
+    session.ros_namespace = ros.ros_namespace;
+    session.robot_control = ros.robot_control;
+  }
 
   LaunchContext context;
   context.seed = session.seed;
+  if (source) {
+    context.replay_source = source->data_path;
+    context.yoked_to = source->id;
+  }
   context.session_id = session.id;
   context.data_dir = (std::filesystem::absolute(config_.data_dir) / "sessions" /
                       (std::to_string(session.id) + "-" + session.uid))

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "cli/command_line.hpp"
+#include "contract/replay_flags.hpp"
 #include "contract/task_bounds.hpp"
 #include "contract/validators.hpp"
 
@@ -135,13 +136,16 @@ void declare_sim_options(CLI::App& app, SimOptions& o) {
                  "record the session there: session.json, trajectories.csv, events.jsonl\n"
                  "(docs/data.md); without it nothing is recorded")
       ->type_name("DIR")->check(non_empty());
-  app.add_option("--replay", o.replay,
+  CLI::Option* replay = app.add_option("--replay", o.replay,
                  "show the session recorded in DIR (a --data-dir folder) at its own pace, view-only;\n"
                  "it ends with outcome 'watched' (docs/replay.md)")
-      ->type_name("DIR")->check(non_empty())
-      ->excludes("--scenario")->excludes("--seed")->excludes("--crowd")->excludes("--robot-control")
-      ->excludes("--time-limit")->excludes("--avatar-start")->excludes("--avatar-goal")->excludes("--robot-start")
-      ->excludes("--robot-goal");
+      ->type_name("DIR")->check(non_empty());
+  // The recording's world, as it was: options that would make another are refused beside it.
+  for (const std::string_view flag : contract::kWorldFlags) replay->excludes(std::string(flag));
+  app.add_option("--yoked-to", o.yoked_to,
+                 "with --replay: the recorded session's id in sim_manager's index, kept in the\n"
+                 "watcher's session.json as yoked_to (sim_manager sets it)")
+      ->type_name("ID")->needs("--replay")->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 53));
   app.add_option("--uid", o.uid, "participant id recorded in session.json (letters, digits, - and _)")
       ->type_name("ID")->check(satisfies(is_identifier));
   const char* code_help = "completion code shown when the task is done (--code-success) or the time is up\n"

@@ -48,6 +48,8 @@ struct SimOptions {
   std::string data_dir;             ///< record session data here (docs/data.md); empty = nothing recorded
   /// Play this recorded session folder to viewers instead of a live one (docs/replay.md); empty = live.
   std::string replay;
+  /// With --replay: the recorded session's id in sim_manager's index, written as the watcher's yoked_to.
+  std::optional<std::int64_t> yoked_to;
   std::string uid;                  ///< participant id for session.json
   std::string code_success;         ///< completion code shown on success (SEAN-EP's t1); empty = none
   std::string code_timeout;         ///< completion code shown on timeout (t2); empty = none

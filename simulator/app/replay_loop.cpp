@@ -35,6 +35,9 @@ namespace {
 // How long the recording's last picture stays after its end when --end-grace does not say, s: long enough to
 // see that it ended, short beside the recording itself.
 constexpr int kWatchedHoldS = 3;
+// With a completion code of the watcher's own (--code-success), as long as a live session shows its code by
+// default: time to copy it where the page is not inside a survey that hears it.
+constexpr int kWatchedCodeHoldS = 15;
 
 }  // namespace
 
@@ -58,16 +61,17 @@ int run_replay(const SimOptions& options, const std::atomic<bool>& stop) {
                                          std::to_string(picture.width) + "x" + std::to_string(picture.height) +
                                          " at " + std::to_string(picture.fps) + " fps cannot be shown");
   }
-  rfbsim::log::info("sim_rfb", "replaying %s: scenario %s, uid '%s', %llu ticks at %d Hz, %dx%d at %d fps",
-                    options.replay.c_str(), meta.scenario.c_str(), meta.uid.c_str(),
-                    static_cast<unsigned long long>(replay.end_tick()), meta.tick_hz, picture.width, picture.height,
-                    picture.fps);
+  // Not the recording's folder or uid: this log is the watcher's, and the folder's name holds the walker's uid.
+  rfbsim::log::info("sim_rfb", "replaying a session of scenario %s: %llu ticks at %d Hz, %dx%d at %d fps",
+                    meta.scenario.c_str(), static_cast<unsigned long long>(replay.end_tick()), meta.tick_hz,
+                    picture.width, picture.height, picture.fps);
+  replay.set_watcher_code(options.code_success);
+  const std::string address_key = address_hash_key();
   std::unique_ptr<WatchRecord> record;
   if (!options.data_dir.empty()) {
-    record = std::make_unique<WatchRecord>(options.data_dir, options.uid, options.replay, meta);
+    record = std::make_unique<WatchRecord>(options.data_dir, options.uid, meta, options.yoked_to, address_key);
   }
 
-  const std::string address_key = address_hash_key();
   StatusBoard status;
   ClientChanges client_changes;
   rfbsim::ServerOptions server_options = server_options_of(options, picture, status, client_changes, address_key);
@@ -104,7 +108,8 @@ int run_replay(const SimOptions& options, const std::atomic<bool>& stop) {
   std::optional<StreamReporter> stream_reporter;
   if (options.ready_fd) stream_reporter.emplace(*options.ready_fd);
   FrameSchedule frames(std::chrono::nanoseconds(1'000'000'000LL / picture.fps));
-  const auto hold = std::chrono::seconds(options.end_grace.value_or(kWatchedHoldS));
+  const auto hold = std::chrono::seconds(
+      options.end_grace.value_or(options.code_success.empty() ? kWatchedHoldS : kWatchedCodeHoldS));
   bool playing = false;
   std::optional<Clock::time_point> hold_until;  // set at the recording's end
   std::string end_reason = "signal";

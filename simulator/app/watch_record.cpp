@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// WatchRecord: watch.json, written at the start and replaced at the end.
+// WatchRecord: the watcher's session.json, written at the start and replaced at the end.
 #include "app/watch_record.hpp"
 
 #include <stdexcept>
 #include <system_error>
 
 #include "app/session_setup.hpp"
+#include "record/digest.hpp"
 #include "record/file_io.hpp"
 #include "record/session_writer.hpp"
 
@@ -19,19 +20,24 @@ nlohmann::json text_or_null(const std::optional<std::string>& text) {
 
 }  // namespace
 
-WatchRecord::WatchRecord(const std::filesystem::path& data_dir, const std::string& uid,
-                         const std::filesystem::path& recording, const SessionMeta& meta)
+WatchRecord::WatchRecord(const std::filesystem::path& data_dir, const std::string& uid, const SessionMeta& meta,
+                         std::optional<std::int64_t> yoked_to, const std::string& uid_key)
     : dir_(data_dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw std::runtime_error(dir_.string() + ": cannot create the folder (" + ec.message() + ")");
-  const std::filesystem::path absolute = std::filesystem::absolute(recording, ec);
+  const std::string source_hash = hash_uid(uid_key, meta.uid);
   doc_ = {{"kind", "replay"},
+          {"condition", "video"},
           {"uid", uid},
-          // What was shown: enough to find the recording again and to tell it from another of the same walker.
+          {"yoked_to", yoked_to ? nlohmann::json(*yoked_to) : nlohmann::json(nullptr)},
+          {"yoked_to_uid_hash", source_hash},
+          {"scenario", meta.scenario},
+          {"camera", std::string(camera_mode_name(meta.camera))},
+          // What was shown: enough to tell it from another recording of the same walker, and nothing that
+          // names them (their folder's name holds their uid).
           {"replay_of",
-           {{"dir", (ec ? recording : absolute).lexically_normal().string()},
-            {"uid", meta.uid},
+           {{"uid_hash", source_hash},
             {"scenario", meta.scenario},
             {"seed", std::to_string(meta.seed)},
             {"started_at", meta.started_at},
@@ -63,8 +69,8 @@ std::string WatchRecord::write() {
   if (!dir_fd.valid()) return error;
   // Text of any bytes (a uid, a folder name) is replaced rather than thrown over: the record must be written.
   const std::string text = doc_.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-  const FileResult result = replace_file(dir_, dir_fd.get(), "watch.json", text);
-  return result.ok() ? "" : (dir_ / "watch.json").string() + ": " + result.error;
+  const FileResult result = replace_file(dir_, dir_fd.get(), "session.json", text);
+  return result.ok() ? "" : (dir_ / "session.json").string() + ": " + result.error;
 }
 
 }  // namespace rfbsim::sim

@@ -39,7 +39,14 @@ WatchedReplay::~WatchedReplay() = default;
 
 TaskText WatchedReplay::text() const {
   const TaskMonitor& task = replay_->study().task();
-  return watched_task_text(task.spec(), task.status());
+  TaskText text = watched_task_text(task.spec(), task.status());
+  if (ended_ && !watcher_code_.empty()) {
+    // The watcher's own code, like a walker's at their outcome: the survey hears it too, the picture shows it
+    // for a participant whose survey is not listening.
+    text.corner.clear();
+    text.centre = {"The recording has ended. Thank you!", "Your completion code:", watcher_code_};
+  }
+  return text;
 }
 
 bool WatchedReplay::advance(int ticks) {

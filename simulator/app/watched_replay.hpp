@@ -34,8 +34,11 @@ class WatchedReplay {
   /// The tick the recording ends at (replay::recorded_end_tick).
   [[nodiscard]] std::uint64_t end_tick() const { return replay_->end_tick(); }
 
-  /// What the HUD shows the watcher now: the walker's HUD less its prompts (watched_task_text).
+  /// What the HUD shows the watcher now: the walker's HUD less its prompts (watched_task_text), and once the
+  /// recording has ended the watcher's own completion code, if set_watcher_code gave one.
   [[nodiscard]] TaskText text() const;
+  /// The watcher's completion code (the video condition's, sim_rfb --code-success); "" = none to show.
+  void set_watcher_code(std::string code) { watcher_code_ = std::move(code); }
 
   /// Plays up to `ticks` more ticks of the recording; at its end tick, applies the last inputs and stops.
   /// Returns whether the recording has ended. Throws sim::SessionLogError for inputs out of tick order.
@@ -51,6 +54,7 @@ class WatchedReplay {
   SessionLog log_;  // before replay_, which reads it for its whole life
   std::unique_ptr<replay::SessionReplay> replay_;
   bool ended_ = false;
+  std::string watcher_code_;
 };
 
 /// Throws replay::RecordingError when `data_dir` (the watcher's --data-dir) is the recording's folder or

@@ -45,6 +45,8 @@ std::string hash_address(const std::string& key, const std::string& address) {
   return to_hex(digest, std::min(length, 8u));
 }
 
+std::string hash_uid(const std::string& key, const std::string& uid) { return hash_address(key, "uid:" + uid); }
+
 std::string sha256_file(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw std::runtime_error(file.string() + ": cannot read it to take its digest");

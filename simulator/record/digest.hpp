@@ -15,6 +15,11 @@ std::string address_hash_key();
 /// hash could be reversed by trying them all; the key stops that.
 std::string hash_address(const std::string& key, const std::string& address);
 
+/// The first 16 hex digits of HMAC-SHA256(key, "uid:" + uid): how a participant is named in another
+/// participant's records (a watcher's yoked_to_uid_hash), never by the uid itself. Keyed like addresses, so that
+/// a list of known uids cannot be tried against it; the prefix keeps a uid from hashing like an address.
+std::string hash_uid(const std::string& key, const std::string& uid);
+
 /// SHA-256 of a file's bytes as 64 hex digits. Throws std::runtime_error naming the file when it cannot
 /// be read.
 std::string sha256_file(const std::filesystem::path& file);

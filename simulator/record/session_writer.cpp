@@ -116,6 +116,8 @@ SessionWriter::SessionWriter(std::filesystem::path dir, SessionInfo info, const 
                                     : json(nullptr)},
               {"robot_control", info_.robot_control.empty() ? json(nullptr) : json(info_.robot_control)},
               {"camera", info_.camera},
+              // A watcher's session.json says "video" (app/watch_record.hpp): the study's two conditions.
+              {"condition", "interactive"},
               {"ros",
                {{"bag", info_.ros_bag.empty() ? json(nullptr) : json(info_.ros_bag)},
                 {"bridge", info_.ros_bridge.empty() ? json(nullptr) : json(info_.ros_bridge)},

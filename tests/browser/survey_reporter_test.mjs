@@ -49,8 +49,10 @@ check('each event goes once to each configured origin, and only there', () => {
   reporter.started();
   reporter.started();
   assert.deepEqual(parent.posted, [
-    { message: { type: 'rfbsim', event: 'started', uid: 'P1', code: null }, origin: 'https://survey.example' },
-    { message: { type: 'rfbsim', event: 'started', uid: 'P1', code: null }, origin: 'https://other.example' },
+    { message: { type: 'rfbsim', event: 'started', uid: 'P1', code: null, outcome: null },
+      origin: 'https://survey.example' },
+    { message: { type: 'rfbsim', event: 'started', uid: 'P1', code: null, outcome: null },
+      origin: 'https://other.example' },
   ]);
   assert.ok(parent.posted.every(({ origin }) => origin !== '*'));
 });
@@ -71,8 +73,20 @@ check('the outcome carries its code, comes after started, and ended repeats the 
   reporter.started();
   reporter.update(status({ outcome: 'timeout', code: 'LATE-2', survey_origins: ['https://survey.example'] }));
   reporter.ended();
-  assert.deepEqual(parent.posted.map(({ message }) => [message.event, message.code]),
-                   [['started', null], ['timeout', 'LATE-2'], ['ended', 'LATE-2']]);
+  assert.deepEqual(parent.posted.map(({ message }) => [message.event, message.code, message.outcome]),
+                   [['started', null, null], ['timeout', 'LATE-2', 'timeout'], ['ended', 'LATE-2', 'timeout']]);
+});
+
+check('a watcher shown the recording to its end hears watched with the video condition code', () => {
+  const parent = fakeParent();
+  const reporter = new SurveyReporter(parent, self);
+  reporter.update(status({ survey_origins: ['https://survey.example'], condition: 'video' }));
+  reporter.started();
+  reporter.update(status({ outcome: 'watched', code: 'VID-7', survey_origins: ['https://survey.example'],
+                           condition: 'video' }));
+  reporter.ended();
+  assert.deepEqual(parent.posted.map(({ message }) => [message.event, message.code, message.outcome]),
+                   [['started', null, null], ['watched', 'VID-7', 'watched'], ['ended', 'VID-7', 'watched']]);
 });
 
 check('a session that never showed a picture and had no outcome sends ended alone', () => {

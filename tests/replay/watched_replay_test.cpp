@@ -114,7 +114,7 @@ TEST_CASE("sim_rfb --replay shows a recorded session to its end as sim_replay fi
   const auto b_dir = test::fresh_dir("watched_b_" + camera);
   test::PipedSim b(test::sim_rfb_path(),
                    {"--replay", a_dir.string(), "--port", "0", "--data-dir", b_dir.string(), "--uid", "w-watcher",
-                    "--end-grace", "600"},
+                    "--yoked-to", "7", "--end-grace", "600"},
                    {}, a_dir.parent_path() / ("watched_b_" + camera + ".log"));
   const std::string ready = b.await_line("ready ", std::chrono::seconds(60));
   REQUIRE(!ready.empty());
@@ -173,20 +173,28 @@ TEST_CASE("sim_rfb --replay shows a recorded session to its end as sim_replay fi
   for (const std::string& line : b.lines()) outcome_lines += line.rfind("outcome ", 0) == 0 ? 1 : 0;
   CHECK(outcome_lines == 1);
 
-  // The watcher's record names what was replayed and how it ended; no session of its own, no inputs.
-  CHECK_FALSE(std::filesystem::exists(b_dir / "session.json"));
+  // The watcher's record: a session.json of condition video naming what was replayed (by id and a hash of its
+  // walker's uid, never the uid or its folder) and how it ended; no trajectories or inputs of its own.
+  CHECK_FALSE(std::filesystem::exists(b_dir / "trajectories.csv"));
   CHECK_FALSE(std::filesystem::exists(b_dir / "events.jsonl"));
-  std::ifstream watch_file(b_dir / "watch.json");
-  const nlohmann::json watch = nlohmann::json::parse(watch_file);
+  std::ifstream watch_file(b_dir / "session.json");
+  const std::string watch_text((std::istreambuf_iterator<char>(watch_file)), std::istreambuf_iterator<char>());
+  const nlohmann::json watch = nlohmann::json::parse(watch_text);
   CHECK(watch["kind"] == "replay");
+  CHECK(watch["condition"] == "video");
   CHECK(watch["uid"] == "w-watcher");
+  CHECK(watch["yoked_to"] == 7);
+  CHECK(watch["yoked_to_uid_hash"].get<std::string>().size() == 16);
+  CHECK(watch["replay_of"]["uid_hash"] == watch["yoked_to_uid_hash"]);
+  CHECK(watch["scenario"] == a.meta.scenario);
+  CHECK(watch["camera"] == camera);
   CHECK(watch["outcome"] == "watched");
   CHECK(watch["end_reason"] == "watched");
   CHECK(watch["end_tick"] == *a.meta.end_tick);
   CHECK(watch["viewers"] == 2);
-  CHECK(watch["replay_of"]["uid"] == "p-walker");
-  CHECK(std::filesystem::equivalent(watch["replay_of"]["dir"].get<std::string>(), a_dir));
   CHECK(watch["ended_at"].is_string());
+  CHECK(watch_text.find("p-walker") == std::string::npos);
+  CHECK(watch_text.find(a_dir.filename().string()) == std::string::npos);
 
   // A is as it was: nothing written into the recording.
   CHECK(folder_bytes(a_dir) == a_before);

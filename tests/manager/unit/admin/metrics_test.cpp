@@ -175,6 +175,7 @@ TEST_CASE("rejections are counted by reason and every reason is listed") {
             "rfbsim_rejections_total{reason=\"unspent_limit\"} 0",
             "rfbsim_rejections_total{reason=\"head_preview\"} 0",
             "rfbsim_rejections_total{reason=\"cannot_record\"} 0",
+            "rfbsim_rejections_total{reason=\"no_recording\"} 0",
         });
 }
 

@@ -110,3 +110,23 @@ TEST_CASE("admission: each address has its own /start bucket - an empty one is t
   CHECK(admission.decide("not a query%", "198.51.100.7", kNow, kUnixNow).kind == Kind::kRefused);
   CHECK(admission.decide("uid=p02", "198.51.100.7", kNow, kUnixNow).kind == Kind::kAdmitted);
 }
+
+TEST_CASE("admission: a video link's yoke_uid needs signed links, and condition video needs sim_rfb") {
+  ManagerConfig config;
+  CHECK(decide_once(config, "uid=b1&scenario=lab&condition=video").kind == Kind::kAdmitted);
+  const StartDecision unsigned_pin = decide_once(config, "uid=b1&scenario=lab&condition=video&yoke_uid=a1");
+  REQUIRE(unsigned_pin.kind == Kind::kRefused);
+  CHECK(unsigned_pin.status == 400);
+  CHECK(unsigned_pin.message.find("yoke_uid is offered only on signed links") != std::string::npos);
+  config.link_secret = "s3cret";
+  const StartDecision signed_pin =
+      decide_once(config, sign_query("uid=b1&scenario=lab&condition=video&yoke_uid=a1", config.link_secret));
+  REQUIRE(signed_pin.kind == Kind::kAdmitted);
+  CHECK(signed_pin.request->yoke_uid == "a1");
+  ManagerConfig program;
+  program.session_kind = rfbsim::manager::SessionKind::kRfb;
+  program.scenarios.clear();
+  const StartDecision not_sim = decide_once(program, "uid=b1&condition=video");
+  REQUIRE(not_sim.kind == Kind::kRefused);
+  CHECK(not_sim.message.find("only sim_rfb sessions are recorded to be replayed") != std::string::npos);
+}

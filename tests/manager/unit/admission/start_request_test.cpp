@@ -538,3 +538,43 @@ TEST_CASE("robot_control on a scenario with a robot is a mode, not a spawn point
     CHECK(parsed.request->overrides == std::vector<std::pair<std::string, std::string>>{{"robot_control", value}});
   }
 }
+
+TEST_CASE("condition is interactive by default, or video, and a video link sets no world of its own") {
+  CHECK(parse_with("uid", "p01").request->condition == "interactive");
+  CHECK(parse_with("condition", "interactive").request->condition == "interactive");
+  CHECK(parse_with("condition", "video").request->condition == "video");
+  for (const char* bad : {"Video", "", "watch", "video "}) {
+    CAPTURE(bad);
+    const StartParse parsed = parse_with("condition", bad);
+    REQUIRE_FALSE(parsed.request);
+    CHECK(parsed.error.find("use interactive or video") != std::string::npos);
+  }
+  // The recording's seed, poses, crowd, robot and view are the walker's: a video link may not set them.
+  for (const auto& [name, value] : std::vector<std::pair<std::string, std::string>>{
+           {"seed", "7"}, {"crowd", "3"}, {"camera", "first_person"}, {"avatar_start", "1,2,0"}, {"robot_control", "builtin"}}) {
+    CAPTURE(name);
+    const StartParse parsed =
+        parse_start_request(QueryParams{{"uid", "p01"}, {"scenario", "lab"}, {"condition", "video"}, {name, value}}, kScenarios);
+    REQUIRE_FALSE(parsed.request);
+    CHECK(parsed.error == name + " is not valid with condition=video: the watcher is shown the recorded session as it was");
+  }
+  // Codes are the watcher's own.
+  const StartParse coded =
+      parse_start_request(QueryParams{{"uid", "p01"}, {"condition", "video"}, {"t1", "VID-1"}}, kScenarios);
+  REQUIRE(coded.request);
+  CHECK(coded.request->code_success == "VID-1");
+}
+
+TEST_CASE("yoke_uid is an identifier, and only for a video link") {
+  const StartParse pinned =
+      parse_start_request(QueryParams{{"uid", "b1"}, {"condition", "video"}, {"yoke_uid", "a-7"}}, kScenarios);
+  REQUIRE(pinned.request);
+  CHECK(pinned.request->yoke_uid == "a-7");
+  const StartParse alone = parse_with("yoke_uid", "a-7");
+  REQUIRE_FALSE(alone.request);
+  CHECK(alone.error == "yoke_uid is for condition=video links only");
+  const StartParse bad =
+      parse_start_request(QueryParams{{"uid", "b1"}, {"condition", "video"}, {"yoke_uid", "a/7"}}, kScenarios);
+  REQUIRE_FALSE(bad.request);
+  CHECK(bad.error.find("yoke_uid 'a/7' is not valid") != std::string::npos);
+}

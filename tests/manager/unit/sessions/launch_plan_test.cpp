@@ -443,3 +443,24 @@ TEST_CASE("an x11 session runs rfbsim_x11_session with its display and the progr
              "--depth", "24", "--xvnc", "/usr/bin/Xvnc", "--ready-fd", "3", "--", "/usr/bin/glxgears", "-geometry",
              "640x480+0+0", "--log=/data/3-p01/p01.log", "7", ""});
 }
+
+TEST_CASE("a watcher's sim_rfb replays the source's folder, with no world of its own and no timeout code") {
+  ManagerConfig config;
+  // A walker's time limit and crowd in the study's extra arguments would make --replay refuse to start.
+  config.session_args = {"--time-limit", "30", "--quality", "70", "--crowd=4", "--end-grace", "5"};
+  StartRequest r = request("lab");
+  r.condition = "video";
+  r.code_success = "VID-1";
+  r.code_timeout = "LATE-1";
+  LaunchContext context{7, 0, "/data/sessions/9-p01", "/run/s/9.sock"};
+  context.replay_source = "/data/sessions/3-a1";
+  context.yoked_to = 3;
+  CHECK(session_arguments(config, r, context) ==
+        Args{"--quality", "70", "--end-grace", "5", "--unix-socket", "/run/s/9.sock", "--rfb-only", "--ready-fd", "3",
+             "--replay", "/data/sessions/3-a1", "--yoked-to", "3", "--proxy-protocol", "--data-dir",
+             "/data/sessions/9-p01", "--uid", "p01", "--codec", "auto", "--code-success", "VID-1"});
+  // The index's parameters say video, and never name a pinned walker.
+  r.yoke_uid = "a1";
+  CHECK(parameters_json(r, 7) == R"({"uid":"p01","scenario":"lab","seed":"7","t1":"VID-1","t2":"LATE-1",)"
+                                 R"("condition":"video","yoke_pinned":true})");
+}

@@ -110,6 +110,7 @@ TEST_CASE("the admin API's session JSON names every field, and the token only wh
       R"("ended_at":null,"data_path":"/data/sessions/7-p-01","outcome":null,)"
       R"("copy_state":"","copy_attempts":0,"copy_error":"",)"
       R"("params":{"uid":"p-01","scenario":"lab","seed":"42"},"ros_namespace":null,"robot_control":null,)"
+      R"("condition":"interactive","yoked_to":null,"yoked_to_uid_hash":null,"watchers":0,)"
       R"("codec":null,"rtt_ms":null,"fps":null,"quality":null)";
   CHECK(rfbsim::manager::admin_session_json(s, false) == expected + "}");
   CHECK(rfbsim::manager::admin_session_json(s, true) == expected + R"(,"token":"0123456789abcdef0123456789abcdef"})");
@@ -153,7 +154,8 @@ TEST_CASE("the session record beside the data says how the session ended, with n
         "\"detail\":\"no browser connected for 60 s\","
         "\"created_at\":\"2023-11-14T22:13:20.000Z\",\"ready_at\":null,\"spent_at\":null,"
         "\"ended_at\":\"2023-11-14T22:14:21.000Z\",\"outcome\":null,\"data_incomplete\":null,"
-        "\"ros_namespace\":null,\"robot_control\":null}\n");
+        "\"ros_namespace\":null,\"robot_control\":null,\"condition\":\"interactive\",\"yoked_to\":null,"
+        "\"yoked_to_uid_hash\":null}\n");
   session.spent_at = session.created + std::chrono::milliseconds(1500);
   session.data_incomplete = "events.jsonl: cannot write (No space left on device)";
   session.address_hash = "0123456789abcdef";
@@ -170,7 +172,7 @@ TEST_CASE("the researcher sees a session's ROS namespace and robot control, the 
   s.robot_control = "external";
   const std::string admin = rfbsim::manager::admin_session_json(s, false);
   CHECK(admin.find(R"("ros_namespace":"/rfbsim/s_7","robot_control":"external",)") != std::string::npos);
-  CHECK(rfbsim::manager::session_record_json(s).find(R"("ros_namespace":"/rfbsim/s_7","robot_control":"external"})") !=
+  CHECK(rfbsim::manager::session_record_json(s).find(R"("ros_namespace":"/rfbsim/s_7","robot_control":"external",)") !=
         std::string::npos);
   // The participant's page is told nothing of the lab's ROS.
   const std::string status = rfbsim::manager::status_json(s, s.created, {});
@@ -181,5 +183,26 @@ TEST_CASE("the researcher sees a session's ROS namespace and robot control, the 
   s.ros_namespace.clear();
   s.robot_control = "builtin";
   CHECK(rfbsim::manager::admin_session_json(s, false).find(R"("ros_namespace":null,"robot_control":"builtin",)") !=
+        std::string::npos);
+}
+
+TEST_CASE("a watcher's session names the session it was shown by id and uid hash, never by uid") {
+  Session watcher = sample();
+  watcher.condition = "video";
+  watcher.yoked_to = 3;
+  watcher.yoked_to_uid_hash = "00112233aabbccdd";
+  const std::string admin = rfbsim::manager::admin_session_json(watcher, false);
+  CHECK(admin.find(R"("condition":"video","yoked_to":3,"yoked_to_uid_hash":"00112233aabbccdd","watchers":0,)") !=
+        std::string::npos);
+  CHECK(rfbsim::manager::session_record_json(watcher).find(
+            R"("condition":"video","yoked_to":3,"yoked_to_uid_hash":"00112233aabbccdd"})") != std::string::npos);
+  // The page learns that its participant watches (and drops the keyboard hint); an interactive poll is as it was.
+  CHECK(rfbsim::manager::status_json(watcher, watcher.created, {}).find(R"(,"condition":"video"})") !=
+        std::string::npos);
+  CHECK(rfbsim::manager::status_json(sample(), watcher.created, {}).find("condition") == std::string::npos);
+  // The source counts its watchers for the researcher.
+  Session source = sample();
+  source.watchers = 2;
+  CHECK(rfbsim::manager::admin_session_json(source, false).find(R"("yoked_to":null,"yoked_to_uid_hash":null,"watchers":2,)") !=
         std::string::npos);
 }
