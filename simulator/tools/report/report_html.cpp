@@ -140,6 +140,7 @@ void video_pairs(std::string& out, const ReportData& data) {
   if (data.video.watchers == 0) return;
   out += "<h2>Video condition: " + std::to_string(data.video.pairs.size()) + " pairs</h2>\n<p>" +
          html_escape(video_note(data.video)) + " Every column, the source's measures included, is in pairs.csv.</p>\n";
+  if (data.video.pairs.empty()) return;
   Row header;
   for (const PairColumn& c : pair_columns()) {
     if (c.shown) {

@@ -105,6 +105,8 @@ std::string markdown_report(const ReportData& data) {
   if (data.video.watchers > 0) {
     out += "## Video condition: " + std::to_string(data.video.pairs.size()) + " pairs\n\n" +
            markdown_escape(video_note(data.video)) + "\n\n";
+  }
+  if (!data.video.pairs.empty()) {
     header.clear();
     for (const PairColumn& c : pair_columns()) {
       if (c.shown) header.push_back(c.unit.empty() ? c.name : c.name + " (" + c.unit + ")");
