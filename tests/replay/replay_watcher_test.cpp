@@ -69,7 +69,7 @@ TEST_CASE("sim_replay refuses a watcher's folder with one line naming the sessio
   CHECK_FALSE(std::filesystem::exists(root / "b.mp4"));
 }
 
-TEST_CASE("a session.json is a watcher's by its condition or its kind; anything else is left to the strict reader") {
+TEST_CASE("a session.json is a watcher's by its condition or its kind, anything else is left to the strict reader") {
   const auto root = test::fresh_dir("watcher_peek");
   const auto peek = [&](const std::string& text) {
     write_text(root / "session.json", text);
