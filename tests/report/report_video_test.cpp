@@ -81,8 +81,8 @@ void watcher(const std::filesystem::path& sessions, int id, const std::string& u
   write_text(dir / "session.json", doc.dump(2) + "\n");
   write_text(dir / "session.log", "[sim_rfb] replaying\n");
   const nlohmann::json yoked = doc.value("yoked_to", nlohmann::json());
-  write_text(dir / "manager.json",
-             manager_of(uid, id, "video", yoked.is_number_integer() ? std::optional<int>(yoked.get<int>()) : std::nullopt));
+  const std::optional<int> source = yoked.is_number_integer() ? std::optional<int>(yoked.get<int>()) : std::nullopt;
+  write_text(dir / "manager.json", manager_of(uid, id, "video", source));
 }
 
 }  // namespace
@@ -252,9 +252,10 @@ TEST_CASE("a watcher whose source is not in the data is a warning naming both, a
   ScratchDir other;
   interactive(other.path() / "h2" / "sessions", 12, "pA", true);
   watcher(other.path() / "h1" / "sessions", 14, "pB", watcher_json("pB", 12));
-  nlohmann::json a_record = nlohmann::json::parse(read_text(other.path() / "h2" / "sessions" / "12-pA" / "manager.json"));
+  const auto a_manager = other.path() / "h2" / "sessions" / "12-pA" / "manager.json";
+  nlohmann::json a_record = nlohmann::json::parse(read_text(a_manager));
   a_record["host"] = "h2";
-  write_text(other.path() / "h2" / "sessions" / "12-pA" / "manager.json", a_record.dump());
+  write_text(a_manager, a_record.dump());
   const JobResult apart = run_report({other.path() / "h1", other.path() / "h2"}, other.path() / "report");
   CHECK(apart.video_pairs == 0);
   REQUIRE(apart.warnings.size() == 1);

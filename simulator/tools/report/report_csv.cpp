@@ -69,7 +69,7 @@ std::string pairs_csv(const std::vector<SessionMetrics>& sessions, const std::ve
   append_line(out, cells);
   for (const VideoPair& p : pairs) {
     cells.clear();
-    for (const PairColumn& c : pair_columns()) cells.push_back(csv_cell(c.value(p, sessions[p.source], sessions[p.watcher])));
+    for (const PairColumn& c : pair_columns()) cells.push_back(csv_cell(pair_cell(c, p, sessions)));
     append_line(out, cells);
   }
   return out;

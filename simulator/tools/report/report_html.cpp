@@ -152,7 +152,7 @@ void video_pairs(std::string& out, const ReportData& data) {
   for (const VideoPair& p : data.video.pairs) {
     Row row;
     for (const PairColumn& c : pair_columns()) {
-      if (c.shown) row.push_back(html_escape(display_cell(c.value(p, data.sessions[p.source], data.sessions[p.watcher]))));
+      if (c.shown) row.push_back(html_escape(display_cell(pair_cell(c, p, data.sessions))));
     }
     rows.push_back(row);
   }

@@ -116,7 +116,7 @@ std::string markdown_report(const ReportData& data) {
       Row row;
       for (const PairColumn& c : pair_columns()) {
         if (!c.shown) continue;
-        const Value value = c.value(p, data.sessions[p.source], data.sessions[p.watcher]);
+        const Value value = pair_cell(c, p, data.sessions);
         const bool text = std::holds_alternative<std::string>(value);
         row.push_back(text ? markdown_escape(display_cell(value)) : display_cell(value));
       }

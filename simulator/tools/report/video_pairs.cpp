@@ -64,8 +64,8 @@ std::vector<PairColumn> make_pair_columns() {
       pair_column("pair", "", "the pair's number",
                   [](const VideoPair& p, const M&, const M&) { return Value(static_cast<std::int64_t>(p.number)); },
                   true),
-      pair_column("host", "", "the host both ran on", [](const VideoPair&, const M& a, const M&) { return Value(a.host); },
-                  true),
+      pair_column("host", "", "the host both ran on",
+                  [](const VideoPair&, const M& a, const M&) { return Value(a.host); }, true),
       pair_column("scenario", "", "the source's scenario",
                   [](const VideoPair&, const M& a, const M&) { return Value(a.scenario); }, true),
       pair_column("source_session", "", "the source's (A's) session id",
@@ -157,7 +157,8 @@ VideoPairing pair_watchers(const std::vector<SessionMetrics>& sessions) {
     return std::make_tuple(!a.session_id, a.session_id.value_or(0), !b.session_id, b.session_id.value_or(0), a.folder,
                            b.folder);
   };
-  std::sort(out.pairs.begin(), out.pairs.end(), [&](const VideoPair& x, const VideoPair& y) { return key(x) < key(y); });
+  std::sort(out.pairs.begin(), out.pairs.end(),
+            [&](const VideoPair& x, const VideoPair& y) { return key(x) < key(y); });
   for (std::size_t n = 0; n < out.pairs.size(); ++n) out.pairs[n].number = n + 1;
   return out;
 }
@@ -181,6 +182,10 @@ std::string video_count(const VideoPairing& pairing) {
 const std::vector<PairColumn>& pair_columns() {
   static const std::vector<PairColumn> columns = make_pair_columns();
   return columns;
+}
+
+Value pair_cell(const PairColumn& column, const VideoPair& pair, const std::vector<SessionMetrics>& sessions) {
+  return column.value(pair, sessions[pair.source], sessions[pair.watcher]);
 }
 
 }  // namespace rfbsim::report

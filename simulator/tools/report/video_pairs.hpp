@@ -2,7 +2,8 @@
 // The video condition in the report (issue 33): a watcher's row made from its session.json, and each watcher
 // (B) paired with the interactive session it watched (A, its source) for the paired tests: B's yoked_to is A's
 // session id on the same host, and B's replay_of.started_at is A's started_at. pairs.csv and the report's
-// "Video condition" section (report_csv, report_markdown, report_html) are one row per pair: who, how much B watched, and A's measures.
+// "Video condition" section (report_csv, report_markdown, report_html) are one row per pair: who, how much B
+// watched, and A's measures.
 #pragma once
 
 #include <cstddef>
@@ -61,5 +62,8 @@ struct PairColumn {
 /// Every column of pairs.csv, in order: the pair, the source and the watcher, then each of sessions.csv's
 /// measure columns for the source, prefixed `source_`.
 const std::vector<PairColumn>& pair_columns();
+
+/// `column`'s cell for `pair` of `sessions`.
+Value pair_cell(const PairColumn& column, const VideoPair& pair, const std::vector<SessionMetrics>& sessions);
 
 }  // namespace rfbsim::report
