@@ -243,8 +243,8 @@ TEST_CASE("a watcher whose source is not in the data is a warning naming both, a
   CHECK_THAT(pairs, Catch::StartsWith("pair,host,scenario,source_session,source_uid,"));
   const std::string md = read_text(out / "report.md");
   CHECK_THAT(md, Catch::Contains("## Video condition: 0 pairs") &&
-                     Catch::Contains(markdown_escape("3 watchers' sessions, 0 paired; the other 3 are under Warnings, "
-                                                     "with why.")) &&
+                     Catch::Contains(markdown_escape("3 watchers' sessions, 0 paired, 3 not (each under Warnings, "
+                                                     "with why).")) &&
                      !Catch::Contains("| pair |") &&
                      Catch::Contains("## Warnings"));
 

@@ -170,7 +170,7 @@ std::string video_note(const VideoPairing& pairing) {
       "paired with it: B's yoked_to is A's session id on the same host. Watchers walked nowhere, so they are not in "
       "the overview, the measures or summary.csv; each row gives A's measures instead. " +
       std::to_string(pairing.watchers) + " watchers' sessions, " + std::to_string(pairing.pairs.size()) + " paired";
-  out += unpaired == 0 ? "." : "; the other " + std::to_string(unpaired) + " are under Warnings, with why.";
+  out += unpaired == 0 ? "." : ", " + std::to_string(unpaired) + " not (each under Warnings, with why).";
   return out;
 }
 
