@@ -144,7 +144,7 @@ TEST_CASE("Hall-zone bins count each session once per zone in 10-point bins") {
   CHECK(zone_histogram_svg(bins).rfind("<svg", 0) == 0);
 }
 
-TEST_CASE("docs/report.md defines every column of sessions.csv and summary.csv") {
+TEST_CASE("docs/report.md defines every column of sessions.csv, summary.csv and pairs.csv") {
   std::ifstream in(std::string(RFBSIM_SOURCE_DIR) + "/docs/report.md");
   REQUIRE(in.good());
   std::stringstream text;
@@ -159,5 +159,15 @@ TEST_CASE("docs/report.md defines every column of sessions.csv and summary.csv")
     CHECK(docs.find("`pct_" + r.name + "`") != std::string::npos);
   }
   CHECK(docs.find("`excluded_sessions`") != std::string::npos);
-  CHECK(summary_csv_header().size() == 4 + summary_rates().size() + 3 * summarized_columns().size());
+  CHECK(docs.find("`video_sessions`") != std::string::npos);
+  CHECK(summary_csv_header().size() == 5 + summary_rates().size() + 3 * summarized_columns().size());
+  // pairs.csv's own columns; its source_<column> ones are sessions.csv's, defined above.
+  for (const PairColumn& c : pair_columns()) {
+    if (c.name.rfind("source_", 0) == 0 && c.name != "source_session" && c.name != "source_uid" &&
+        c.name != "source_folder" && c.name != "source_outcome" && c.name != "source_in_statistics") {
+      continue;
+    }
+    INFO(c.name);
+    CHECK(docs.find("`" + c.name + "`") != std::string::npos);
+  }
 }

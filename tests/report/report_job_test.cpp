@@ -62,7 +62,7 @@ TEST_CASE("the overall and per-scenario tables give the rates and statistics of 
   const JobResult result = run_report(scratch.path() / "data", out);
   CHECK(result.exit_status() == 0);
   CHECK(result.sessions_reported == 4);
-  CHECK(result.written.size() == 4);
+  CHECK(result.written.size() == 5);  // sessions.csv, summary.csv, pairs.csv, report.md, report.html
 
   const auto rows = csv_records(read_text(out / "sessions.csv"));
   REQUIRE(rows.size() == 4);

@@ -2,37 +2,21 @@
 // SessionCatalog: session folders from several data folders, with their hosts, repeats left out.
 #include "session_catalog.hpp"
 
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <utility>
 
 #include <nlohmann/json.hpp>
 
 #include "record/session_log.hpp"
+#include "small_file.hpp"
 
 namespace rfbsim::tools {
 
 namespace {
 
-// manager.json is a few hundred bytes and session.json a few kB; larger files are not what we look for
-// and are not read into memory.
+// manager.json is a few hundred bytes; a larger file is not what we look for and is not read into memory.
 constexpr std::uintmax_t kMaxRecordBytes = 64 * 1024;
-constexpr std::uintmax_t kMaxSessionJsonBytes = 4 * 1024 * 1024;
 constexpr std::size_t kMaxHostBytes = 64;
-
-// A regular file's bytes, or none when it is missing, unreadable or over `limit`.
-std::optional<std::string> small_file(const std::filesystem::path& file, std::uintmax_t limit) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) return std::nullopt;
-  const std::uintmax_t size = std::filesystem::file_size(file, ec);
-  if (ec || size > limit) return std::nullopt;
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (!in) return std::nullopt;
-  return bytes.str();
-}
 
 // The data folder as given, without a trailing separator ("data/" and "data" are one host).
 std::string folder_label(const std::filesystem::path& data_dir) {
@@ -60,7 +44,7 @@ std::string host_from_layout(const std::filesystem::path& data_dir, const std::f
 }
 
 std::optional<std::string> recorded_host(const std::filesystem::path& dir) {
-  const std::optional<std::string> bytes = small_file(dir / "manager.json", kMaxRecordBytes);
+  const std::optional<std::string> bytes = read_small_file(dir / "manager.json", kMaxRecordBytes);
   if (!bytes) return std::nullopt;
   const nlohmann::json doc = nlohmann::json::parse(*bytes, nullptr, /*allow_exceptions=*/false);
   if (!doc.is_object()) return std::nullopt;
@@ -80,7 +64,9 @@ SessionCatalog catalog_sessions(const std::vector<std::filesystem::path>& data_d
 
   const auto session_json_of = [&](std::size_t index, const std::filesystem::path& dir) {
     auto it = session_json.find(index);
-    if (it == session_json.end()) it = session_json.emplace(index, small_file(dir / "session.json", kMaxSessionJsonBytes)).first;
+    if (it == session_json.end()) {
+      it = session_json.emplace(index, read_small_file(dir / "session.json", kMaxSessionJsonBytes)).first;
+    }
     return it->second;
   };
 
@@ -110,7 +96,7 @@ SessionCatalog catalog_sessions(const std::vector<std::filesystem::path>& data_d
       } else if (const auto it2 = by_host_name.find({found.host, name}); it2 != by_host_name.end()) {
         repeat = RepeatedSession{dir, it2->second, "the same host (" + found.host + ") and folder name"};
       } else if (const auto it3 = by_name.find(name); it3 != by_name.end()) {
-        const std::optional<std::string> mine = small_file(dir / "session.json", kMaxSessionJsonBytes);
+        const std::optional<std::string> mine = read_small_file(dir / "session.json", kMaxSessionJsonBytes);
         for (const std::size_t other : it3->second) {
           // Two hosts that both recorded their ids (and differ) ran two sessions, however alike.
           if (found.host_recorded && catalog.sessions[other].host_recorded) continue;

@@ -46,7 +46,8 @@ std::string host_from_layout(const std::filesystem::path& data_dir, const std::f
 /// Never throws (sim_report warns of a broken manager.json when it reads it in full).
 std::optional<std::string> recorded_host(const std::filesystem::path& dir);
 
-/// Finds every session folder (one holding a session.json) under each of `data_dirs`, in order. A folder
+/// Finds every session folder (one holding a session.json: a watcher's of the video condition too, whose
+/// session.json is all it holds; watcher_session.hpp tells them apart) under each of `data_dirs`, in order. A folder
 /// is one session already in the catalog, and left out as a repeat, when it is the same folder on disk
 /// (overlapping data folders), or has the same host and folder name (a host's data folder and the store
 /// both given), or has the same folder name and a byte-identical session.json while one of the two hosts

@@ -24,6 +24,7 @@
 #include "replay/session_replay.hpp"
 #include "trajectory_diff.hpp"
 #include "video_writer.hpp"
+#include "watcher_session.hpp"
 
 namespace rfbsim::replay {
 
@@ -177,6 +178,11 @@ struct Film {
 };
 
 void run_job(const ReplayOptions& options, const ProgressFn& progress, ReplayResult& result) {
+  // A watcher's folder (the video condition) has nothing of its own to replay: it only watched another session.
+  if (const tools::SessionKind kind = tools::peek_session_kind(options.session_dir); kind.video) {
+    throw JobFailure{kExitRefused, options.session_dir.string() + " is a watcher's session (condition video) of " +
+                                       tools::watched_source(kind.yoked_to) + ": replay its source instead"};
+  }
   // The log, read and checked (replay/recording.hpp: sim_rfb --replay opens recordings alike).
   sim::SessionLog log;
   try {

@@ -48,7 +48,8 @@ using ProgressFn = std::function<void(double done_s, double total_s)>;
 /// recorded it (third person for files older than the key), or the top view fitted to the recorded frame.
 sim::SceneStyle video_style(View view, const sim::SessionMeta& meta);
 
-/// Replays `options.session_dir` as `options` say. Never throws: every failure is a result with its exit
+/// Replays `options.session_dir` as `options` say (a watcher's folder of the video condition is refused: it
+/// recorded nothing to replay). Never throws: every failure is a result with its exit
 /// status and message.
 ReplayResult replay_session(const ReplayOptions& options, const ProgressFn& progress = {});
 

@@ -2,29 +2,19 @@
 // lookup_session: a session by uid or id across data folders.
 #include "session_lookup.hpp"
 
-#include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+
+#include "small_file.hpp"
 
 namespace rfbsim::replay {
 
 namespace {
 
-// session.json is a few kB; a larger one is not read into memory for its uid.
-constexpr std::uintmax_t kMaxSessionJsonBytes = 4 * 1024 * 1024;
-
 // session.json's uid, or none when the file cannot be read or has none.
 std::optional<std::string> uid_of(const std::filesystem::path& dir) {
-  const std::filesystem::path file = dir / "session.json";
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(file, ec);
-  if (ec || size > kMaxSessionJsonBytes) return std::nullopt;
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (!in) return std::nullopt;
-  const nlohmann::json doc = nlohmann::json::parse(bytes.str(), nullptr, /*allow_exceptions=*/false);
+  const std::optional<std::string> bytes = tools::read_small_file(dir / "session.json", tools::kMaxSessionJsonBytes);
+  if (!bytes) return std::nullopt;
+  const nlohmann::json doc = nlohmann::json::parse(*bytes, nullptr, /*allow_exceptions=*/false);
   if (!doc.is_object() || !doc.contains("uid") || !doc["uid"].is_string()) return std::nullopt;
   return doc["uid"].get<std::string>();
 }

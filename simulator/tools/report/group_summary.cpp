@@ -13,14 +13,19 @@ namespace rfbsim::report {
 namespace {
 
 GroupSummary summarize_group(const std::vector<const SessionMetrics*>& members) {
-  // Only the sessions someone took part in; the others are counted, not measured.
+  // Only the interactive sessions someone took part in; the others are counted, not measured.
   std::vector<const SessionMetrics*> group;
-  for (const SessionMetrics* m : members) {
-    if (exclusion_reason(*m).empty()) group.push_back(m);
-  }
   GroupSummary out;
+  for (const SessionMetrics* m : members) {
+    if (m->video()) {
+      ++out.video;
+    } else if (in_statistics(*m)) {
+      group.push_back(m);
+    } else {
+      ++out.excluded;
+    }
+  }
   out.sessions = group.size();
-  out.excluded = members.size() - group.size();
   for (const Rate& rate : summary_rates()) {
     const auto yes = std::count_if(group.begin(), group.end(), [&](const SessionMetrics* m) { return rate.holds(*m); });
     const double n = static_cast<double>(group.size());

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // GroupSummary: the overall tables: for all sessions and for each scenario, the SEAN-EP rates (percent of
-// sessions) and the mean and median of every summarized sessions.csv column, over the sessions that had a
-// participant.
+// sessions) and the mean and median of every summarized sessions.csv column, over the interactive sessions
+// that had a participant (watchers of the video condition are counted apart).
 #pragma once
 
 #include <cstddef>
@@ -51,7 +51,8 @@ struct GroupSummary {
   bool all = false;      ///< all sessions; otherwise one scenario's
   std::string scenario;  ///< the scenario's name ("" for all)
   std::size_t sessions = 0;  ///< N: sessions in the statistics
-  std::size_t excluded = 0;  ///< the group's sessions left out: no participant (exclusion_reason)
+  std::size_t excluded = 0;  ///< the group's interactive sessions left out: no participant (exclusion_reason)
+  std::size_t video = 0;     ///< the group's watchers (the video condition): counted apart, never measured
   std::vector<double> rate_percent;    ///< % of sessions, parallel to summary_rates()
   std::vector<Statistic> statistics;   ///< parallel to summarized_columns()
 };
@@ -60,8 +61,8 @@ struct GroupSummary {
 const std::vector<std::string>& summarized_columns();
 
 /// All sessions first, then each scenario in name order. Sessions without a participant (exclusion_reason)
-/// are left out of the rates and statistics and counted in `excluded`; a scenario whose sessions are all
-/// left out still has its line, with N 0.
+/// are left out of the rates and statistics and counted in `excluded`, watchers (the video condition) in
+/// `video`; a scenario whose sessions are all left out still has its line, with N 0.
 std::vector<GroupSummary> summarize(const std::vector<SessionMetrics>& sessions);
 
 /// The statistic of `values` (any order).

@@ -75,6 +75,10 @@ int run(const rfbsim::report::CliOptions& options) {
     rfbsim::log::info(kTag, "%zu of them without a participant (link never spent), left out of the statistics",
                       result.sessions_excluded);
   }
+  if (result.video_sessions > 0) {
+    rfbsim::log::info(kTag, "%zu video-condition pairs (%zu watchers' sessions, counted apart from the statistics)",
+                      result.video_pairs, result.video_sessions);
+  }
   for (const std::filesystem::path& file : result.written) std::printf("%s\n", file.c_str());
   return result.exit_status();
 }

@@ -44,6 +44,14 @@ std::optional<long long> time(const json& doc, const char* key, const std::files
   return millis;
 }
 
+// The integer under `key` (a session id); absent or null is none.
+std::optional<std::int64_t> integer(const json& doc, const char* key, const std::filesystem::path& file) {
+  const auto it = doc.find(key);
+  if (it == doc.end() || it->is_null()) return std::nullopt;
+  if (!it->is_number_integer()) fail(file, std::string("key '") + key + "': expected an integer");
+  return it->get<std::int64_t>();
+}
+
 bool known_state(std::string_view state) {
   std::string_view all = manager_states();
   while (!all.empty()) {
@@ -114,6 +122,15 @@ ManagerRecord parse_manager_record(const std::string& bytes, const std::filesyst
   record.detail = text(doc, "detail", file, false).value_or("");
   record.data_incomplete = text(doc, "data_incomplete", file, false);
   record.host = text(doc, "host", file, false);
+  record.id = integer(doc, "id", file);
+
+  // The study's condition (issue 33): a watcher names the session it watched; older files are interactive.
+  record.condition = text(doc, "condition", file, false).value_or("interactive");
+  if (record.condition != "interactive" && record.condition != "video") {
+    fail(file, "key 'condition': expected interactive or video, got '" + record.condition + "'");
+  }
+  record.yoked_to = integer(doc, "yoked_to", file);
+  record.yoked_to_uid_hash = text(doc, "yoked_to_uid_hash", file, false);
 
   // When the link was spent, counted from the manager creating the session (both on the manager's clock).
   const long long created = *time(doc, "created_at", file, false);

@@ -4,6 +4,7 @@
 // another program: a broken one is a warning naming the file, and the session is reported without it.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -28,6 +29,12 @@ struct ManagerRecord {
   std::optional<std::string> data_incomplete;  ///< the reason sim_rfb gave the manager; none when complete
   /// The host id of the manager that ran the session; none in files from managers that did not record it.
   std::optional<std::string> host;
+  /// The session's id on its host (the `<id>` of its `<id>-<uid>` folder); none in files without it.
+  std::optional<std::int64_t> id;
+  /// "interactive" or "video" (a watcher of another session's replay); interactive in older files.
+  std::string condition = "interactive";
+  std::optional<std::int64_t> yoked_to;  ///< a watcher's source session id on the same host; none otherwise
+  std::optional<std::string> yoked_to_uid_hash;  ///< keyed hash of the source's uid (hex); none otherwise
 };
 
 /// Every state manager.json may hold, space-separated in the manager's order.

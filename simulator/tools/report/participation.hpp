@@ -13,12 +13,18 @@
 
 namespace rfbsim::report {
 
-/// Copies manager.json's state, detail and spent time into `metrics`, and its data_incomplete reason when
-/// session.json gave none.
+/// Copies manager.json's state, detail, spent time and session id into `metrics`, its data_incomplete reason
+/// when session.json gave none, and a watcher's yoked_to when session.json gave none.
 void add_manager_record(const ManagerRecord& record, SessionMetrics& metrics);
 
-/// Why `metrics` is left out of the statistics ("abandoned: ..."), or "" when it counts.
+/// Why `metrics` is left out of the statistics for want of a participant ("abandoned: ..."), or "" when it
+/// had one. A watcher's session (the video condition) is judged alike but never counts: see in_statistics.
 std::string exclusion_reason(const SessionMetrics& metrics);
+
+/// Whether `metrics` counts in the statistics (summary.csv, the overview, the measures, the histograms): an
+/// interactive session with a participant. Watchers (the video condition) walked nowhere: they are counted
+/// apart (GroupSummary::video) and their sources' measures are in pairs.csv instead.
+bool in_statistics(const SessionMetrics& metrics);
 
 /// How many sessions were left out for one reason.
 struct Exclusion {
@@ -26,7 +32,7 @@ struct Exclusion {
   std::size_t sessions = 0;  ///< at least 1
 };
 
-/// The reasons `sessions` were left out for, each once with its count, in the order first met.
+/// The reasons the interactive `sessions` were left out for, each once with its count, in the order first met.
 std::vector<Exclusion> exclusions(const std::vector<SessionMetrics>& sessions);
 
 }  // namespace rfbsim::report

@@ -55,18 +55,27 @@ Column column(const char* name, const char* unit, const char* meaning, std::func
   return Column{name, unit, meaning, std::move(value), summarized, shown};
 }
 
-std::vector<Column> make_columns() {
+Value maybe_id(const std::optional<std::int64_t>& id) { return id ? Value(*id) : Value(); }
+
+// Who and what: every session has these, a watcher's (the video condition) too.
+std::vector<Column> who_columns() {
   // name, unit, meaning, value, summarized, shown
   return {
       column("folder", "", "session folder, relative to the data folder",
              [](const M& m) { return Value(m.folder); }, false, true),
       column("uid", "", "participant id from the link", [](const M& m) { return Value(m.uid); }, false, true),
       column("scenario", "", "scenario name", [](const M& m) { return Value(m.scenario); }, false, true),
+      column("condition", "", "interactive (walked the scenario) or video (watched another's session)",
+             [](const M& m) { return Value(std::string(m.video() ? "video" : "interactive")); }, false, true),
+      column("yoked_to", "", "a watcher's source: the session_id it watched, on the same host; empty otherwise",
+             [](const M& m) { return m.watcher ? maybe_id(m.watcher->yoked_to) : Value(); }, false, true),
       column("scenario_file", "", "scenario file the session was run from",
              [](const M& m) { return Value(m.scenario_file); }),
       column("seed", "", "master seed", [](const M& m) { return Value(m.seed); }),
       column("host", "", "host that ran it: manager.json's host, else the data folder's layout",
              [](const M& m) { return Value(m.host); }, false, true),
+      column("session_id", "", "the session's id on its host (manager.json's id, else the folder's <id>-)",
+             [](const M& m) { return maybe_id(m.session_id); }),
       column("duplicate_uid", "", "its uid also has a session on another host (drop it, or all of that uid's)",
              [](const M& m) { return Value(m.duplicate_uid); }, false, true),
       column("outcome", "", "completed, timeout, or empty", [](const M& m) { return Value(m.outcome); }, false, true),
@@ -81,8 +90,16 @@ std::vector<Column> make_columns() {
              [](const M& m) { return m.has_manager_record ? Value(m.link_spent) : Value(); }, false, true),
       column("link_spent_after", "s", "from the manager creating the session to that first picture",
              [](const M& m) { return maybe(m.link_spent_after); }, false, true),
-      column("in_statistics", "", "counted in summary.csv; no when nobody took part (link never spent)",
-             [](const M& m) { return Value(exclusion_reason(m).empty()); }),
+      column("in_statistics", "", "counted in summary.csv; no when nobody took part (link never spent) or video",
+             [](const M& m) { return Value(in_statistics(m)); }),
+  };
+}
+
+}  // namespace
+
+std::vector<Column> measure_columns() {
+  // name, unit, meaning, value, summarized, shown
+  std::vector<Column> columns = {
       column("duration", "s", "end_tick / tick_hz, else the last sample's time",
              [](const M& m) { return Value(m.duration); }, true, true),
       column("measured_from", "s", "start of what is measured: the task clock's start (first picture)",
@@ -194,12 +211,19 @@ std::vector<Column> make_columns() {
       column("robot_time_stopped", "s", "time with the robot slower than 0.01 m/s, sample to next sample",
              social([](const sim::SocialMetrics& s) { return Value(s.time_stopped); }), true),
   };
+  // A watcher walked nowhere: none of these applies to its row (they are empty, never 0 or "no").
+  for (Column& c : columns) {
+    c.value = [value = std::move(c.value)](const M& m) { return m.video() ? Value() : value(m); };
+  }
+  return columns;
 }
 
-}  // namespace
-
 const std::vector<Column>& session_columns() {
-  static const std::vector<Column> columns = make_columns();
+  static const std::vector<Column> columns = [] {
+    std::vector<Column> all = who_columns();
+    for (Column& c : measure_columns()) all.push_back(std::move(c));
+    return all;
+  }();
   return columns;
 }
 

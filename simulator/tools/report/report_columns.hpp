@@ -27,8 +27,12 @@ struct Column {
   bool shown = false;       ///< in the session table of report.md and report.html (the CSV has them all)
 };
 
-/// Every column of sessions.csv, in order.
+/// Every column of sessions.csv, in order: who and what (folder to in_statistics), then the measures.
 const std::vector<Column>& session_columns();
+
+/// The measure columns of sessions.csv (duration on), in order: empty in a watcher's row (the video condition);
+/// pairs.csv gives them for each watcher's source.
+std::vector<Column> measure_columns();
 
 /// The column named `name`; throws std::out_of_range when there is none (a programming error).
 const Column& session_column(const std::string& name);

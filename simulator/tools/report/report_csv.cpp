@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
-// sessions.csv and summary.csv.
+// sessions.csv, summary.csv and pairs.csv.
 #include "report_csv.hpp"
 
 #include "report_columns.hpp"
@@ -35,7 +35,7 @@ std::string sessions_csv(const std::vector<SessionMetrics>& sessions) {
 }
 
 std::vector<std::string> summary_csv_header() {
-  std::vector<std::string> names = {"scope", "scenario", "sessions", "excluded_sessions"};
+  std::vector<std::string> names = {"scope", "scenario", "sessions", "excluded_sessions", "video_sessions"};
   for (const Rate& rate : summary_rates()) names.push_back("pct_" + rate.name);
   for (const std::string& column : summarized_columns()) {
     names.push_back(column + "_n");
@@ -50,13 +50,26 @@ std::string summary_csv(const std::vector<GroupSummary>& groups) {
   append_line(out, summary_csv_header());
   for (const GroupSummary& g : groups) {
     std::vector<std::string> cells = {g.all ? "all" : "scenario", csv_field(g.scenario), std::to_string(g.sessions),
-                                      std::to_string(g.excluded)};
+                                      std::to_string(g.excluded), std::to_string(g.video)};
     for (const double pct : g.rate_percent) cells.push_back(format_number(pct, 6));
     for (const Statistic& s : g.statistics) {
       cells.push_back(std::to_string(s.n));
       cells.push_back(optional_number(s.mean));
       cells.push_back(optional_number(s.median));
     }
+    append_line(out, cells);
+  }
+  return out;
+}
+
+std::string pairs_csv(const std::vector<SessionMetrics>& sessions, const std::vector<VideoPair>& pairs) {
+  std::string out;
+  std::vector<std::string> cells;
+  for (const PairColumn& c : pair_columns()) cells.push_back(c.name);
+  append_line(out, cells);
+  for (const VideoPair& p : pairs) {
+    cells.clear();
+    for (const PairColumn& c : pair_columns()) cells.push_back(csv_cell(pair_cell(c, p, sessions)));
     append_line(out, cells);
   }
   return out;

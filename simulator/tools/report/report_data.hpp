@@ -9,6 +9,7 @@
 #include "group_summary.hpp"
 #include "participation.hpp"
 #include "session_metrics.hpp"
+#include "video_pairs.hpp"
 
 namespace rfbsim::report {
 
@@ -41,7 +42,8 @@ struct ReportData {
   std::vector<std::string> warnings;    ///< reported all the same, e.g. a broken manager.json (names the file)
   std::vector<DuplicateUid> duplicates;  ///< uids with sessions on more than one host (flag_duplicate_uids)
   std::vector<RepeatedFolder> repeats;   ///< folders found twice, reported once
-  std::vector<SessionPlot> plots;            ///< parallel to sessions; may be empty (no plots)
+  VideoPairing video;                    ///< pair_watchers(sessions): the video condition's pairs
+  std::vector<SessionPlot> plots;            ///< parallel to sessions (a watcher's is empty); may be empty (no plots)
   std::vector<std::string> map_definitions;  ///< MapDrawing::definition of every map the plots use
 };
 

@@ -88,7 +88,7 @@ void histograms(std::string& out, const ReportData& data) {
   out += "<h2>Time in Hall's zones (the robot's closest person, the avatar included)</h2>\n";
   std::map<std::string, std::vector<const SessionMetrics*>> by_scenario;
   for (const SessionMetrics& m : data.sessions) {
-    if (exclusion_reason(m).empty()) by_scenario[m.scenario].push_back(&m);  // the participants' sessions only
+    if (in_statistics(m)) by_scenario[m.scenario].push_back(&m);  // the participants' sessions only
   }
   for (const auto& [scenario, sessions] : by_scenario) {
     out += "<figure>" + zone_histogram_svg(zone_bins(sessions)) + "<figcaption>Scenario " +
@@ -127,11 +127,36 @@ void plots(std::string& out, const ReportData& data) {
          "where each began, a square where it ended; walls dark, props light grey.</p>\n";
   for (std::size_t i = 0; i < data.sessions.size(); ++i) {
     const SessionMetrics& m = data.sessions[i];
+    if (m.video()) continue;  // a watcher walked nowhere
     out += "<details><summary>" + html_escape(m.folder) + " &#8212; uid " + html_escape(m.uid) + ", " +
            html_escape(m.scenario) + ", " + html_escape(m.outcome.empty() ? "no outcome" : m.outcome) +
            "</summary><figure>" + data.plots[i].svg + "<figcaption>" + html_escape(data.plots[i].caption) +
            "</figcaption></figure></details>\n";
   }
+}
+
+// The video condition's pairs, when there are watchers.
+void video_pairs(std::string& out, const ReportData& data) {
+  if (data.video.watchers == 0) return;
+  out += "<h2>Video condition: " + std::to_string(data.video.pairs.size()) + " pairs</h2>\n<p>" +
+         html_escape(video_note(data.video)) + " Every column, the source's measures included, is in pairs.csv.</p>\n";
+  if (data.video.pairs.empty()) return;
+  Row header;
+  for (const PairColumn& c : pair_columns()) {
+    if (c.shown) {
+      header.push_back("<span title=\"" + html_escape(c.meaning) + "\">" + html_escape(c.name) + "</span>" +
+                       (c.unit.empty() ? "" : " (" + html_escape(c.unit) + ")"));
+    }
+  }
+  std::vector<Row> rows;
+  for (const VideoPair& p : data.video.pairs) {
+    Row row;
+    for (const PairColumn& c : pair_columns()) {
+      if (c.shown) row.push_back(html_escape(display_cell(pair_cell(c, p, data.sessions))));
+    }
+    rows.push_back(row);
+  }
+  html_table(out, header, rows);
 }
 
 // Uids on two hosts (said whenever the report spans hosts, "none" included) and folders found twice.
@@ -199,11 +224,13 @@ std::string html_report(const ReportData& data) {
          (data.data_dirs.size() == 1 ? "Data folder: " : "Data folders: ") + folders + "<br>" +
          std::to_string(data.sessions.size()) + " sessions reported (" + std::to_string(data.groups.front().sessions) +
          " in the statistics, " + std::to_string(data.groups.front().excluded) +
-         " without a participant left out), " + std::to_string(data.skipped.size()) +
+         " without a participant left out" + html_escape(video_count(data.video)) + "), " +
+         std::to_string(data.skipped.size()) +
          " skipped. Definitions of every measure: docs/report.md.</p>\n";
   overview(out, data);
   histograms(out, data);
   session_table(out, data);
+  video_pairs(out, data);
   hosts(out, data);
   left_out(out, data);
   plots(out, data);

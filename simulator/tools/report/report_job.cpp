@@ -6,6 +6,8 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <stdexcept>
+#include <utility>
 
 #include "duplicate_uids.hpp"
 #include "manager_record.hpp"
@@ -19,6 +21,8 @@
 #include "session_catalog.hpp"
 #include "session_samples.hpp"
 #include "trajectory_plot.hpp"
+#include "video_pairs.hpp"
+#include "watcher_session.hpp"
 
 namespace rfbsim::report {
 
@@ -84,15 +88,26 @@ std::string folder_name(const tools::FoundSession& found, std::size_t data_dirs)
 
 // manager.json into `metrics`, when the folder has one. A broken one, or one of another participant (a folder
 // pieced together by hand), is a warning: the session is then reported as if run without the manager.
-void add_record(const std::filesystem::path& dir, const sim::SessionLog& log, SessionMetrics& metrics,
-                std::vector<std::string>& warnings) {
+void add_record(const std::filesystem::path& dir, SessionMetrics& metrics, std::vector<std::string>& warnings) {
   try {
     const std::optional<ManagerRecord> record = read_manager_record(dir);
     if (!record) return;
-    if (record->uid != log.meta.uid) {
-      warnings.push_back((dir / "manager.json").string() + ": uid '" + record->uid + "' is not session.json's '" +
-                         log.meta.uid + "'; ignored");
+    const std::string file = (dir / "manager.json").string();
+    if (record->uid != metrics.uid) {
+      warnings.push_back(file + ": uid '" + record->uid + "' is not session.json's '" + metrics.uid + "'; ignored");
       return;
+    }
+    // session.json is sim_rfb's account of what the session was; the manager's differing is worth a look.
+    const std::string condition = metrics.video() ? "video" : "interactive";
+    if (record->condition != condition) {
+      warnings.push_back(file + ": condition '" + record->condition + "', but session.json is a" +
+                         (metrics.video() ? " watcher's (video)" : "n interactive session's") +
+                         "; reported as session.json says");
+    }
+    if (metrics.watcher && metrics.watcher->yoked_to && record->yoked_to &&
+        *metrics.watcher->yoked_to != *record->yoked_to) {
+      warnings.push_back(file + ": yoked_to " + std::to_string(*record->yoked_to) + ", but session.json's is " +
+                         std::to_string(*metrics.watcher->yoked_to) + "; paired as session.json says");
     }
     add_manager_record(*record, metrics);
   } catch (const ManagerRecordError& e) {
@@ -100,6 +115,32 @@ void add_record(const std::filesystem::path& dir, const sim::SessionLog& log, Se
   } catch (const std::exception& e) {
     warnings.push_back((dir / "manager.json").string() + ": " + e.what() + "; reported without it");
   }
+}
+
+// The session id a sim_manager folder's name gives ("12-p007": 12); none for any other name.
+std::optional<std::int64_t> id_from_folder_name(const std::filesystem::path& dir) {
+  const std::string name = dir.lexically_normal().filename().string();
+  const std::size_t dash = name.find('-');
+  if (dash == 0 || dash == std::string::npos || dash > 18) return std::nullopt;
+  if (name.find_first_not_of("0123456789") != dash) return std::nullopt;
+  return std::stoll(name.substr(0, dash));
+}
+
+// One session folder measured (an interactive session) or described (a watcher's), with its plot.
+std::pair<SessionMetrics, SessionPlot> report_session(const std::filesystem::path& dir, MapCache& maps) {
+  const tools::SessionKind kind = tools::peek_session_kind(dir);
+  if (!kind.unknown_condition.empty()) {
+    throw std::runtime_error((dir / "session.json").string() + ": key 'condition': '" + kind.unknown_condition +
+                             "' is neither interactive nor video");
+  }
+  // A watcher's folder holds its session.json alone: nothing was walked, so there is nothing to plot.
+  if (kind.video) return {watcher_metrics(tools::read_watcher_session(dir)), SessionPlot{}};
+  const sim::SessionLog log = sim::read_session(dir);
+  const SampledSession samples = assemble_samples(log);
+  SessionMetrics metrics = session_metrics(log, samples);
+  const LoadedMap& map = maps.get(log.meta.scenario_file);
+  SessionPlot plot{trajectory_svg(samples, map.drawing ? &*map.drawing : nullptr), caption(log, samples, map)};
+  return {std::move(metrics), std::move(plot)};
 }
 
 // Writes a whole file through a temporary and a rename, so that a reader never sees half a report.
@@ -148,17 +189,16 @@ JobResult run_report(const std::vector<std::filesystem::path>& data_dirs, const 
   for (std::size_t i = 0; i < found.size(); ++i) {
     const std::string folder = folder_name(found[i], data_dirs.size());
     try {
-      const sim::SessionLog log = sim::read_session(found[i].dir);
-      const SampledSession samples = assemble_samples(log);
-      SessionMetrics metrics = session_metrics(log, samples);
+      auto [metrics, plot] = report_session(found[i].dir, maps);
       metrics.folder = folder;
       metrics.host = found[i].host;
-      add_record(found[i].dir, log, metrics, data.warnings);
-      const LoadedMap& map = maps.get(log.meta.scenario_file);
-      SessionPlot plot{trajectory_svg(samples, map.drawing ? &*map.drawing : nullptr), caption(log, samples, map)};
+      metrics.session_id = id_from_folder_name(found[i].dir);
+      add_record(found[i].dir, metrics, data.warnings);
       data.sessions.push_back(std::move(metrics));
       data.plots.push_back(std::move(plot));
     } catch (const sim::SessionLogError& e) {
+      data.skipped.push_back({folder, e.what()});
+    } catch (const tools::WatcherSessionError& e) {
       data.skipped.push_back({folder, e.what()});
     } catch (const std::exception& e) {
       data.skipped.push_back({folder, std::string("cannot be reported: ") + e.what()});
@@ -170,6 +210,11 @@ JobResult run_report(const std::vector<std::filesystem::path>& data_dirs, const 
   for (const tools::RepeatedSession& r : catalog.repeats) {
     data.repeats.push_back({r.dir.string(), folder_name(found[r.kept], data_dirs.size()), r.why});
   }
+  // Each watcher with the session it watched; one without is a warning that names both.
+  data.video = pair_watchers(data.sessions);
+  for (const std::string& w : data.video.warnings) data.warnings.push_back(w);
+  result.video_sessions = data.video.watchers;
+  result.video_pairs = data.video.pairs.size();
   data.duplicates = flag_duplicate_uids(data.sessions);
   for (const DuplicateUid& d : data.duplicates) result.duplicate_uids.push_back(duplicate_uid_line(d, data.sessions));
   result.repeats = data.repeats;
@@ -189,6 +234,7 @@ JobResult run_report(const std::vector<std::filesystem::path>& data_dirs, const 
   }
   write_file(out_dir / "sessions.csv", sessions_csv(data.sessions), result);
   write_file(out_dir / "summary.csv", summary_csv(data.groups), result);
+  write_file(out_dir / "pairs.csv", pairs_csv(data.sessions, data.video.pairs), result);
   write_file(out_dir / "report.md", markdown_report(data), result);
   write_file(out_dir / "report.html", html_report(data), result);
   return result;

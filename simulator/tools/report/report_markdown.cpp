@@ -48,8 +48,9 @@ std::string markdown_report(const ReportData& data) {
   for (const std::string& d : data.data_dirs) folders += (folders.empty() ? "" : ", ") + markdown_escape(d);
   out += (data.data_dirs.size() == 1 ? "Data folder: " : "Data folders: ") + folders + "  \n";
   out += std::to_string(data.sessions.size()) + " sessions reported (" + std::to_string(data.groups.front().sessions) +
-         " in the statistics, " + std::to_string(data.groups.front().excluded) + " without a participant left out), " +
-         std::to_string(data.skipped.size()) + " skipped. Definitions of every measure: docs/report.md.\n\n";
+         " in the statistics, " + std::to_string(data.groups.front().excluded) + " without a participant left out" +
+         video_count(data.video) + "), " + std::to_string(data.skipped.size()) +
+         " skipped. Definitions of every measure: docs/report.md.\n\n";
 
   // The SEAN-EP rates per group.
   out += "## Overview (% of sessions)\n\n";
@@ -100,6 +101,30 @@ std::string markdown_report(const ReportData& data) {
   }
   markdown_table(out, header, rows);
   out += "Every column, unrounded: sessions.csv.\n\n";
+
+  if (data.video.watchers > 0) {
+    out += "## Video condition: " + std::to_string(data.video.pairs.size()) + " pairs\n\n" +
+           markdown_escape(video_note(data.video)) + "\n\n";
+  }
+  if (!data.video.pairs.empty()) {
+    header.clear();
+    for (const PairColumn& c : pair_columns()) {
+      if (c.shown) header.push_back(c.unit.empty() ? c.name : c.name + " (" + c.unit + ")");
+    }
+    rows.clear();
+    for (const VideoPair& p : data.video.pairs) {
+      Row row;
+      for (const PairColumn& c : pair_columns()) {
+        if (!c.shown) continue;
+        const Value value = pair_cell(c, p, data.sessions);
+        const bool text = std::holds_alternative<std::string>(value);
+        row.push_back(text ? markdown_escape(display_cell(value)) : display_cell(value));
+      }
+      rows.push_back(row);
+    }
+    markdown_table(out, header, rows);
+    out += "Every column, the source's measures included: pairs.csv.\n\n";
+  }
 
   // A uid on two hosts: said whenever the report spans hosts, so that "none" is a finding too.
   if (!data.duplicates.empty() || host_count(data.sessions) > 1) {

@@ -95,6 +95,7 @@ SessionMetrics session_metrics(const sim::SessionLog& log, const SampledSession&
   out.scenario = meta.scenario;
   out.scenario_file = meta.scenario_file;
   out.seed = std::to_string(meta.seed);
+  out.started_at = meta.started_at;
   out.outcome = meta.outcome.value_or("");
   out.end_reason = meta.end_reason.value_or("");
   out.ended_cleanly = meta.ended_at.has_value();

@@ -22,6 +22,17 @@ constexpr double kSeanPersonal = 1.2;   // m
 /// An avatar that walked less than this over the whole session never moved.
 constexpr double kNeverMovedPath = 0.1;  // m
 
+/// What a watcher's session (the video condition) adds to its row: whose session it watched, and how much of it.
+struct WatcherMetrics {
+  std::optional<std::int64_t> yoked_to;  ///< the source's session id on the same host; none when run by hand
+  std::string yoked_to_uid_hash;         ///< keyed hash of the source's uid (hex); "" when unknown
+  std::string source_started_at;         ///< the source's started_at as the watcher's replay_of says
+  std::optional<std::uint64_t> source_end_tick;  ///< the recording's length in ticks (replay_of.end_tick)
+  std::optional<std::uint64_t> end_tick;         ///< the recording's tick reached when the watching ended
+  std::optional<double> watched_s;  ///< s, ended_at - started_at of the watcher's session.json; none unended
+  std::int64_t viewers = 0;         ///< viewer connections that came
+};
+
 /// One session's row of the report.
 struct SessionMetrics {
   // Who and what.
@@ -30,9 +41,16 @@ struct SessionMetrics {
   /// tools::host_from_layout).
   std::string host;
   bool duplicate_uid = false;  ///< its uid has sessions on more than one host (flag_duplicate_uids)
+  /// The session's id on its host: manager.json's `id`, else the `<id>` of an `<id>-<uid>` folder name.
+  std::optional<std::int64_t> session_id;
   std::string uid, scenario, scenario_file, seed;
-  std::string outcome;     ///< completed, timeout or "" (none)
-  std::string end_reason;  ///< completed, timeout, signal, error or "" (did not end cleanly)
+  std::string started_at;  ///< session.json's, ISO 8601 UTC (a watcher's source is told by it)
+  /// A watcher's session (condition video): none for an interactive one. A watcher walked nowhere, so its
+  /// measures below are left at their defaults and its row's measure columns are empty.
+  std::optional<WatcherMetrics> watcher;
+  [[nodiscard]] bool video() const { return watcher.has_value(); }
+  std::string outcome;     ///< completed, timeout, watched (a watcher shown the whole recording) or "" (none)
+  std::string end_reason;  ///< completed, timeout, watched, signal, error or "" (did not end cleanly)
   bool ended_cleanly = false;  ///< session.json has ended_at
   double duration = 0.0;       ///< s: end_tick / tick_hz, else the last sample's time
   /// s: what the measures below cover: from the task clock's start (the participant's first picture; else
