@@ -11,6 +11,8 @@
 // end picture and the video's last frame show the same still moment (see watched_replay_test.cpp).
 #include <catch2/catch.hpp>
 
+#include <sys/wait.h>
+
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -204,4 +206,24 @@ TEST_CASE("a video link shows a watcher the walker's ended session through sim_m
   CHECK(api_entry(manager, a_row->id)["watchers"] == 1);
   CHECK(api_entry(manager, a_row->id)["condition"] == "interactive");
   CHECK(manager.metric("rfbsim_rejections_total{reason=\"no_recording\"}") >= 3);
+
+  // sim_report on the study's data folder: the condition columns, and the pair (A, B) ready for paired tests.
+  const auto report_dir = data.path() / "report-out";
+  const test::ExitResult reported =
+      test::run_to_exit(RFBSIM_SIM_REPORT, {data.path().string(), "--out", report_dir.string()}, 60s);
+  INFO(reported.output);
+  REQUIRE(WIFEXITED(reported.status));
+  CHECK(WEXITSTATUS(reported.status) == 0);
+  const std::string sessions_csv = file_text_of(report_dir / "sessions.csv");
+  CHECK(sessions_csv.substr(0, sessions_csv.find('\n')).find(",condition,yoked_to,") != std::string::npos);
+  const std::string pairs_csv = file_text_of(report_dir / "pairs.csv");
+  std::istringstream pair_lines(pairs_csv);
+  std::string header, row, extra;
+  std::getline(pair_lines, header);
+  REQUIRE(std::getline(pair_lines, row));
+  CHECK_FALSE(std::getline(pair_lines, extra));  // one pair
+  CHECK(header.rfind("pair,host,scenario,source_session,source_uid,", 0) == 0);
+  CHECK(row.find("," + std::to_string(a_row->id) + ",vid-a,") != std::string::npos);
+  CHECK(row.find("," + std::to_string(b_row->id) + "," + b_uid + ",") != std::string::npos);
+  CHECK(reported.output.find("1 video-condition pair") != std::string::npos);
 }
