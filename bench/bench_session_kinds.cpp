@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-2.0-or-later
 // bench_session_kinds: what one participant's session costs for each of sim_manager's session kinds, at the same
 // picture size: sim_rfb (our simulator, the lab scenario), rfb (examples/mujoco_rfb: MuJoCo linked to librfbsim)
-// and x11 (an unmodified X11 program, glxgears, under TigerVNC's Xvnc, started by rfbsim_x11_session).
+// and x11 (an unmodified X11 program, glxgears, under TigerVNC's Xvnc, started by rfbsim_x11_session); and video,
+// a watcher's session of the video condition (sim_rfb --replay of a lab session recorded first, with a client
+// watching and nobody pressing keys, as in the sim_rfb row).
 //
 // For each kind a sim_manager of its own serves the sessions; for each of R runs:
 //   1. GET /start with a fresh uid, and at once a client (libvncclient behind a WsRfbBridge, as the participant
@@ -54,7 +56,7 @@ struct Options {
   bench::Size size{640, 480};
   int runs = 5;
   int seconds = 10;
-  std::vector<std::string> kinds = {"sim_rfb", "rfb", "x11"};
+  std::vector<std::string> kinds = {"sim_rfb", "video", "rfb", "x11"};
   std::string manager = rfbsim::test::sim_manager_path();  // $RFBSIM_SIM_MANAGER, or the one built here
   std::string mujoco = RFBSIM_BENCH_MUJOCO_RFB;             // "" where the build found no MuJoCo
   std::string x11_program = "/usr/bin/glxgears";
@@ -68,7 +70,8 @@ Options parse_options(int argc, char** argv) {
       "bench_session_kinds",
       "Per session kind at one picture size: start-up to first frame through sim_manager, then S seconds of a\n"
       "client taking updates while the session's process group is read from /proc (CPU cores, RSS, processes),\n"
-      "R runs each. Kinds: sim_rfb (the lab scenario), rfb (mujoco_rfb), x11 (the X11 program under Xvnc).\n"
+      "R runs each. Kinds: sim_rfb (the lab scenario), video (a watcher: sim_rfb --replay of a lab session\n"
+      "recorded first), rfb (mujoco_rfb), x11 (the X11 program under Xvnc).\n"
       "sim_manager's and its sessions' output go to the log.");
   cli.size("--size", o.size, "the picture's size, 160x120 .. 3840x2160")
       // sim_rfb's and mujoco_rfb's own bounds, so that a size one of them refuses fails here, clearly.
@@ -81,8 +84,8 @@ Options parse_options(int argc, char** argv) {
           "one WIDTHxHEIGHT in 160x120 .. 3840x2160"));
   cli.number("--runs", o.runs, 1, 100, "runs per kind");
   cli.number("--seconds", o.seconds, 1, 600, "seconds measured per run");
-  cli.list("--kinds", o.kinds, bench::item_of({"sim_rfb", "rfb", "x11"}, "--kinds"),
-           "session kinds: sim_rfb, rfb, x11");
+  cli.list("--kinds", o.kinds, bench::item_of({"sim_rfb", "video", "rfb", "x11"}, "--kinds"),
+           "session kinds: sim_rfb, video, rfb, x11");
   cli.text("--manager", o.manager, "the sim_manager to run");
   cli.app().add_option("--mujoco", o.mujoco, "the mujoco_rfb to run (default: the one built here)")->type_name("TEXT");
   cli.text("--x11-program", o.x11_program, "the X11 program");
@@ -102,6 +105,7 @@ struct KindPlan {
   std::string missing;             // why the kind cannot run here ("" when it can)
   std::vector<std::string> flags;  // sim_manager's flags beyond the data folder and port
   std::string link_extra;          // appended to "uid=..." in /start
+  std::chrono::seconds source{0};  // video: how long a walker's session to record first, for every run to watch
 };
 
 bool is_executable(const std::string& path) { return !path.empty() && ::access(path.c_str(), X_OK) == 0; }
@@ -119,13 +123,20 @@ KindPlan plan_for(const std::string& kind, const Options& o) {
       {"--max-sessions", "1", "--admin-token", bench::kBenchAdminToken, "--max-duration-s", "3600"});
   const std::string width = std::to_string(o.size.width);
   const std::string height = std::to_string(o.size.height);
-  if (kind == "sim_rfb") {
+  if (kind == "sim_rfb" || kind == "video") {
     // The sim_rfb beside the manager (its default session program) at its default 30 fps.
     plan.program = "sim_rfb --scenario lab";
     if (!is_executable(o.manager)) plan.missing = "sim_manager not found at " + o.manager;
     plan.flags.insert(plan.flags.end(), {"--scenarios", "lab"});
     add_session_args(plan.flags, {"--width", width, "--height", height});
     plan.link_extra = "&scenario=lab";
+    if (kind == "video") {
+      // Every run watches the one recording: long enough for the first frame, the warm-up and the window.
+      plan.program = "sim_rfb --replay (lab)";
+      plan.flags.insert(plan.flags.end(), {"--yoke-max-viewers", "1000"});
+      plan.link_extra += "&condition=video";
+      plan.source = std::chrono::seconds(o.seconds + 10);
+    }
   } else if (kind == "rfb") {
     plan.program = std::filesystem::path(o.mujoco).filename().string();
     if (!is_executable(o.mujoco)) {
@@ -257,6 +268,25 @@ RunResult run_once(const ManagerUnderTest& manager, const KindPlan& plan, const 
   return r;
 }
 
+// video: the walker's session every run watches: a lab session with a client taking updates for plan.source
+// (nobody presses keys: the crowd and the robot move), then ended by the researcher.
+void record_source(const ManagerUnderTest& manager, const KindPlan& plan) {
+  const std::string uid = "bench-kinds-" + std::to_string(::getpid()) + "-source";
+  const std::string token = rfbsim::test::token_from_redirect(manager.start("uid=" + uid + "&scenario=lab"));
+  if (token.empty()) throw std::runtime_error("/start of the source session " + uid + " failed");
+  {
+    const rfbsim::test::WsRfbBridge bridge(manager.ws_url(token), manager.origin());
+    rfbsim::test::RfbTestClient client("127.0.0.1", bridge.port());
+    client.pump_until([] { return false; }, plan.source);
+    if (client.updates() == 0) throw std::runtime_error("the source session " + uid + " showed nothing");
+  }
+  const IndexRow row = bench::wait_for_row(manager, token, [](const IndexRow& x) { return !x.spent_at.empty(); },
+                                           kEndTimeout, "spent");
+  bench::end_session(manager, row.id);
+  bench::wait_for_row(manager, token, [](const IndexRow& x) { return !bench::is_live_state(x.state); }, kEndTimeout,
+                      "ended");
+}
+
 std::vector<RunResult> run_kind(const KindPlan& plan, const Options& o) {
   rfbsim::test::TempDir data("rfbsim-bench-kinds");
   rfbsim::test::ManagerOptions how;
@@ -266,6 +296,7 @@ std::vector<RunResult> run_kind(const KindPlan& plan, const Options& o) {
   how.poll_interval = std::chrono::milliseconds(5);
   const bench::StderrToFile redirect(o.log);
   ManagerUnderTest manager(data.path(), plan.flags, how);
+  if (plan.source.count() > 0) record_source(manager, plan);
   std::vector<RunResult> results;
   for (int i = 0; i < o.runs; ++i) results.push_back(run_once(manager, plan, o, i));
   return results;
