@@ -27,6 +27,7 @@ import {
   check, log, pageState, parseManagerArgs, poll, recordPage, runTest, serveHtmlPage, sleep, startSim,
   stopSimCleanly,
 } from './e2e_support.mjs';
+import { demoState, describeMessages as describe, rawMessages, recordAllMessages } from './survey_messages.mjs';
 
 // ---------------------------------------------------------------------------------------------------------------
 // Settings.
@@ -64,21 +65,6 @@ async function startDemoServer(name, demoFile) {
   return origin;
 }
 
-// Records, in the top window only, every message event whatever its origin: window.__e2eMessages.
-function recordAllMessages() {
-  if (window !== window.top) {
-    return;
-  }
-  window.__e2eMessages = [];
-  window.addEventListener('message', (event) => {
-    const data = event.data && typeof event.data === 'object' ? event.data : { value: String(event.data) };
-    window.__e2eMessages.push({ origin: event.origin, ...data });
-  });
-}
-
-const demoState = (page) => page.evaluate(() => JSON.parse(JSON.stringify(window.surveyDemo || null)));
-const rawMessages = (page) => page.evaluate(() => window.__e2eMessages || []);
-const describe = (messages) => messages.map((m) => `${m.event}${m.code ? `(${m.code})` : ''}`).join(', ') || 'none';
 
 // The events the demo accepted on one of its pages.
 async function eventsOn(page, demoPage) {

@@ -29,6 +29,7 @@ import {
   PIXEL_CHANGE_THRESHOLD, changedFraction, check, log, openPage, pageState, parseManagerArgs, poll, recordPage,
   runTest, serveHtmlPage, sleep, snapshot, startSim, stopSimCleanly, thumbnail, waitForConnection, waitForPicture,
 } from './e2e_support.mjs';
+import { demoState, describeMessages as describe, rawMessages, recordAllMessages } from './survey_messages.mjs';
 
 // ---------------------------------------------------------------------------------------------------------------
 // Settings.
@@ -86,21 +87,6 @@ async function sessionOf(uid) {
   return rows[0] || null;
 }
 
-// Records, in the top window only, every message event whatever its origin: window.__e2eMessages.
-function recordAllMessages() {
-  if (window !== window.top) {
-    return;
-  }
-  window.__e2eMessages = [];
-  window.addEventListener('message', (event) => {
-    const data = event.data && typeof event.data === 'object' ? event.data : { value: String(event.data) };
-    window.__e2eMessages.push({ origin: event.origin, ...data });
-  });
-}
-
-const demoState = (page) => page.evaluate(() => JSON.parse(JSON.stringify(window.surveyDemo || null)));
-const rawMessages = (page) => page.evaluate(() => window.__e2eMessages || []);
-const describe = (messages) => messages.map((m) => `${m.event}${m.code ? `(${m.code})` : ''}`).join(', ') || 'none';
 
 // Waits until the demo accepted `event` on its session page; returns that page's messages.
 function waitForEvent(page, event, timeoutMs) {
