@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_record.hpp"
 #include "small_file.hpp"
 
 namespace rfbsim::tools {
@@ -16,40 +17,15 @@ using json = nlohmann::json;
   throw WatcherSessionError(file.string() + ": " + what);
 }
 
-// The value under `key` of `doc` when it is there and not null.
-const json* present(const json& doc, const char* key) {
-  const auto it = doc.find(key);
-  return it == doc.end() || it->is_null() ? nullptr : &*it;
-}
+using Record = JsonRecord<WatcherSessionError>;
 
-// A string key; absent or null is none, or an error when `required`. `where` prefixes the key in errors
-// ("replay_of." for the nested object).
-std::optional<std::string> text(const json& doc, const char* key, const std::filesystem::path& file, bool required,
-                                const std::string& where = "") {
-  const json* value = present(doc, key);
-  if (!value) {
-    if (required) fail(file, "key '" + where + key + "': missing");
-    return std::nullopt;
-  }
-  if (!value->is_string()) fail(file, "key '" + where + key + "': expected a string");
-  return value->get<std::string>();
-}
-
-// A non-negative integer key; absent or null is none.
-std::optional<std::uint64_t> count(const json& doc, const char* key, const std::filesystem::path& file,
+// A non-negative integer key of `object`; absent or null is none.
+std::optional<std::uint64_t> count(const Record& record, const json& object, const char* key,
                                    const std::string& where = "") {
-  const json* value = present(doc, key);
+  const json* value = Record::present(object, key);
   if (!value) return std::nullopt;
-  if (!value->is_number_unsigned()) fail(file, "key '" + where + key + "': expected a whole number");
+  if (!value->is_number_unsigned()) record.fail("key '" + where + key + "': expected a whole number");
   return value->get<std::uint64_t>();
-}
-
-// An integer key (a manager's session id); absent or null is none.
-std::optional<std::int64_t> integer(const json& doc, const char* key, const std::filesystem::path& file) {
-  const json* value = present(doc, key);
-  if (!value) return std::nullopt;
-  if (!value->is_number_integer()) fail(file, std::string("key '") + key + "': expected an integer or null");
-  return value->get<std::int64_t>();
 }
 
 }  // namespace
@@ -75,38 +51,32 @@ SessionKind peek_session_kind(const std::filesystem::path& dir) {
 }
 
 WatcherSession parse_watcher_session(const std::string& bytes, const std::filesystem::path& file) {
-  json doc;
-  try {
-    doc = json::parse(bytes);
-  } catch (const json::exception& e) {
-    fail(file, std::string("not JSON (") + e.what() + ")");
-  }
-  if (!doc.is_object()) fail(file, "expected a JSON object");
-  if (const auto condition = text(doc, "condition", file, false); condition && *condition != "video") {
-    fail(file, "key 'condition': '" + *condition + "' in a watcher's session (expected video)");
+  const Record doc(bytes, file);
+  if (const auto condition = doc.text("condition", false); condition && *condition != "video") {
+    doc.fail("key 'condition': '" + *condition + "' in a watcher's session (expected video)");
   }
 
   WatcherSession w;
-  w.uid = *text(doc, "uid", file, true);
-  w.yoked_to = integer(doc, "yoked_to", file);
-  w.yoked_to_uid_hash = text(doc, "yoked_to_uid_hash", file, false).value_or("");
-  w.camera = text(doc, "camera", file, false).value_or("");
-  w.started_at = *text(doc, "started_at", file, true);
-  w.ended_at = text(doc, "ended_at", file, false);
-  w.end_tick = count(doc, "end_tick", file);
-  w.end_reason = text(doc, "end_reason", file, false);
-  w.outcome = text(doc, "outcome", file, false);
-  w.viewers = static_cast<std::int64_t>(count(doc, "viewers", file).value_or(0));
+  w.uid = *doc.text("uid", true);
+  w.yoked_to = doc.integer("yoked_to", "an integer or null");
+  w.yoked_to_uid_hash = doc.text("yoked_to_uid_hash", false).value_or("");
+  w.camera = doc.text("camera", false).value_or("");
+  w.started_at = *doc.text("started_at", true);
+  w.ended_at = doc.text("ended_at", false);
+  w.end_tick = count(doc, doc.doc(), "end_tick");
+  w.end_reason = doc.text("end_reason", false);
+  w.outcome = doc.text("outcome", false);
+  w.viewers = static_cast<std::int64_t>(count(doc, doc.doc(), "viewers").value_or(0));
 
   // What was shown: the source as its own session.json described it.
-  const json* source = present(doc, "replay_of");
-  if (!source) fail(file, "key 'replay_of': missing");
-  if (!source->is_object()) fail(file, "key 'replay_of': expected an object");
-  w.source_started_at = text(*source, "started_at", file, false, "replay_of.").value_or("");
-  w.source_seed = text(*source, "seed", file, false, "replay_of.").value_or("");
-  w.source_end_tick = count(*source, "end_tick", file, "replay_of.");
-  const std::optional<std::string> source_scenario = text(*source, "scenario", file, false, "replay_of.");
-  w.scenario = text(doc, "scenario", file, false).value_or(source_scenario.value_or(""));
+  const json* source = Record::present(doc.doc(), "replay_of");
+  if (!source) doc.fail("key 'replay_of': missing");
+  if (!source->is_object()) doc.fail("key 'replay_of': expected an object");
+  w.source_started_at = doc.text("started_at", false, source, "replay_of.").value_or("");
+  w.source_seed = doc.text("seed", false, source, "replay_of.").value_or("");
+  w.source_end_tick = count(doc, *source, "end_tick", "replay_of.");
+  const std::optional<std::string> source_scenario = doc.text("scenario", false, source, "replay_of.");
+  w.scenario = doc.text("scenario", false).value_or(source_scenario.value_or(""));
   return w;
 }
 

@@ -8,13 +8,11 @@
 #include <sstream>
 #include <string_view>
 
-#include <nlohmann/json.hpp>
+#include "json_record.hpp"
 
 namespace rfbsim::report {
 
 namespace {
-
-using json = nlohmann::json;
 
 // manager.json is a few hundred bytes; anything far larger is not one, and is not read into memory.
 constexpr std::uintmax_t kMaxRecordBytes = 64 * 1024;
@@ -23,33 +21,16 @@ constexpr std::uintmax_t kMaxRecordBytes = 64 * 1024;
   throw ManagerRecordError(file.string() + ": " + what);
 }
 
-// The string under `key`; absent or null is none, or an error when `required`.
-std::optional<std::string> text(const json& doc, const char* key, const std::filesystem::path& file, bool required) {
-  const auto it = doc.find(key);
-  if (it == doc.end() || it->is_null()) {
-    if (required) fail(file, std::string("key '") + key + "': missing");
-    return std::nullopt;
-  }
-  if (!it->is_string()) fail(file, std::string("key '") + key + "': expected a string");
-  return it->get<std::string>();
-}
+using Record = tools::JsonRecord<ManagerRecordError>;
 
 // The time under `key` in ms since 1970; none when null (and `nullable`).
-std::optional<long long> time(const json& doc, const char* key, const std::filesystem::path& file, bool nullable) {
-  if (doc.find(key) == doc.end()) fail(file, std::string("key '") + key + "': missing");
-  const std::optional<std::string> value = text(doc, key, file, !nullable);
+std::optional<long long> time(const Record& record, const char* key, bool nullable) {
+  if (record.doc().find(key) == record.doc().end()) record.fail(std::string("key '") + key + "': missing");
+  const std::optional<std::string> value = record.text(key, !nullable);
   if (!value) return std::nullopt;
   const std::optional<long long> millis = parse_utc_millis(*value);
-  if (!millis) fail(file, std::string("key '") + key + "': expected an ISO 8601 UTC time, got '" + *value + "'");
+  if (!millis) record.fail(std::string("key '") + key + "': expected an ISO 8601 UTC time, got '" + *value + "'");
   return millis;
-}
-
-// The integer under `key` (a session id); absent or null is none.
-std::optional<std::int64_t> integer(const json& doc, const char* key, const std::filesystem::path& file) {
-  const auto it = doc.find(key);
-  if (it == doc.end() || it->is_null()) return std::nullopt;
-  if (!it->is_number_integer()) fail(file, std::string("key '") + key + "': expected an integer");
-  return it->get<std::int64_t>();
 }
 
 bool known_state(std::string_view state) {
@@ -107,36 +88,29 @@ std::optional<long long> parse_utc_millis(const std::string& text) {
 }
 
 ManagerRecord parse_manager_record(const std::string& bytes, const std::filesystem::path& file) {
-  json doc;
-  try {
-    doc = json::parse(bytes);
-  } catch (const json::exception& e) {
-    fail(file, std::string("not JSON (") + e.what() + ")");
-  }
-  if (!doc.is_object()) fail(file, "expected a JSON object");
-
+  const Record doc(bytes, file);
   ManagerRecord record;
-  record.uid = *text(doc, "uid", file, true);
-  record.state = *text(doc, "state", file, true);
-  if (!known_state(record.state)) fail(file, "key 'state': unknown state '" + record.state + "'");
-  record.detail = text(doc, "detail", file, false).value_or("");
-  record.data_incomplete = text(doc, "data_incomplete", file, false);
-  record.host = text(doc, "host", file, false);
-  record.id = integer(doc, "id", file);
+  record.uid = *doc.text("uid", true);
+  record.state = *doc.text("state", true);
+  if (!known_state(record.state)) doc.fail("key 'state': unknown state '" + record.state + "'");
+  record.detail = doc.text("detail", false).value_or("");
+  record.data_incomplete = doc.text("data_incomplete", false);
+  record.host = doc.text("host", false);
+  record.id = doc.integer("id", "an integer");
 
   // The study's condition (issue 33): a watcher names the session it watched; older files are interactive.
-  record.condition = text(doc, "condition", file, false).value_or("interactive");
+  record.condition = doc.text("condition", false).value_or("interactive");
   if (record.condition != "interactive" && record.condition != "video") {
-    fail(file, "key 'condition': expected interactive or video, got '" + record.condition + "'");
+    doc.fail("key 'condition': expected interactive or video, got '" + record.condition + "'");
   }
-  record.yoked_to = integer(doc, "yoked_to", file);
-  record.yoked_to_uid_hash = text(doc, "yoked_to_uid_hash", file, false);
+  record.yoked_to = doc.integer("yoked_to", "an integer");
+  record.yoked_to_uid_hash = doc.text("yoked_to_uid_hash", false);
 
   // When the link was spent, counted from the manager creating the session (both on the manager's clock).
-  const long long created = *time(doc, "created_at", file, false);
-  if (const std::optional<long long> spent = time(doc, "spent_at", file, true)) {
-    if (*spent < created) fail(file, "spent_at is before created_at");
-    if (record.state == "abandoned") fail(file, "state 'abandoned' with a spent_at: an abandoned link is unspent");
+  const long long created = *time(doc, "created_at", false);
+  if (const std::optional<long long> spent = time(doc, "spent_at", true)) {
+    if (*spent < created) doc.fail("spent_at is before created_at");
+    if (record.state == "abandoned") doc.fail("state 'abandoned' with a spent_at: an abandoned link is unspent");
     record.spent_after = static_cast<double>(*spent - created) / 1000.0;
   }
   return record;
