@@ -219,17 +219,22 @@ std::optional<Session> Supervisor::latest_for_uid(const std::string& uid) {
   return latest;
 }
 
-YokeChoice Supervisor::choose_source(const StartRequest& request) {
-  std::vector<Session> rows = index_.yoking_rows(config_.host_id);
-  // The newest version of each session: a watcher started a moment ago is only queued, and must count.
+void Supervisor::lay_unsaved_over(std::vector<Session>& rows) const {
   for (const auto& [id, queued] : unsaved_) {
     const auto row = std::find_if(rows.begin(), rows.end(), [id = id](const Session& r) { return r.id == id; });
     if (row != rows.end()) {
+      const int watchers = row->watchers;  // the index's count: the table never keeps one
       *row = queued.session;
+      row->watchers = watchers;
     } else {
       rows.push_back(queued.session);
     }
   }
+}
+
+YokeChoice Supervisor::choose_source(const StartRequest& request) {
+  std::vector<Session> rows = index_.yoking_rows(config_.host_id);
+  lay_unsaved_over(rows);  // a watcher started a moment ago is only queued, and must count
   YokeRequest yoke;
   yoke.watcher_uid = request.uid;
   yoke.scenario = request.scenario;
@@ -450,17 +455,7 @@ std::map<SessionState, std::int64_t> Supervisor::counts_by_state() {
 
 std::vector<Session> Supervisor::recent(int limit) {
   std::vector<Session> rows = index_.recent(limit);
-  // Rows still queued for the writer: their newest version replaces the index's, or joins the list.
-  for (const auto& [id, queued] : unsaved_) {
-    const auto row = std::find_if(rows.begin(), rows.end(), [id = id](const Session& r) { return r.id == id; });
-    if (row != rows.end()) {
-      const int watchers = row->watchers;  // the index's count: the table never keeps one
-      *row = queued.session;
-      row->watchers = watchers;
-    } else {
-      rows.push_back(queued.session);
-    }
-  }
+  lay_unsaved_over(rows);
   std::sort(rows.begin(), rows.end(), [](const Session& a, const Session& b) { return a.id > b.id; });
   if (rows.size() > static_cast<std::size_t>(std::max(limit, 0))) rows.resize(static_cast<std::size_t>(std::max(limit, 0)));
   return rows;

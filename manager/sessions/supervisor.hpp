@@ -166,6 +166,9 @@ class Supervisor {
   void launch_recorded(std::int64_t id, LaunchJob job, const std::string& insert_error, StartReply reply);
   // The uid's newest session in the index or among writes still queued.
   std::optional<Session> latest_for_uid(const std::string& uid);
+  // Rows read from the index with the writes still queued laid over them: each queued version replaces its row
+  // (keeping the index's watchers count) or joins the list. Reads must never see an older row than the table.
+  void lay_unsaved_over(std::vector<Session>& rows) const;
   // The session a video-condition link shows (sessions/yoking.hpp), from the index with the writes still queued
   // laid over it. Throws std::runtime_error when the index cannot be read.
   YokeChoice choose_source(const StartRequest& request);
