@@ -86,6 +86,15 @@ TEST_CASE("a video link shows a watcher the walker's ended session through sim_m
   CHECK(early.body.find("No recording to watch right now") != std::string::npos);
   CHECK(early.body.find("outcome: 'unavailable'") != std::string::npos);
 
+  // Bad video links: a clear 400, and the manager serves on.
+  const auto bad_condition = manager.start("uid=vid-bad&scenario=still&condition=watch");
+  CHECK(bad_condition.status == 400);
+  CHECK(bad_condition.body.find("use interactive or video") != std::string::npos);
+  const auto seeded = manager.start("uid=vid-bad&scenario=still&condition=video&seed=3");
+  CHECK(seeded.status == 400);
+  CHECK(seeded.body.find("seed is not valid with condition=video") != std::string::npos);
+  CHECK(manager.start("uid=vid-bad&scenario=still&yoke_uid=vid-a").status == 400);
+
   // A walks: forward, a turn, then stands still, through the manager's relay.
   const std::string a_token = test::token_from_redirect(manager.start("uid=vid-a&scenario=still"));
   REQUIRE(a_token.size() == 32);
