@@ -50,9 +50,13 @@ YokeChoice choose_yoke_source(const std::vector<Session>& sessions, const YokeRe
   for (const Session* watcher : watchers) {
     if (watcher->uid != request.watcher_uid) ++taken[watcher->yoked_to];
   }
-  const auto has_room = [&](const Session* source) {
-    return taken[source->id] < request.max_viewers && recording_present(*source);
+  // Each folder is looked at once per choice: the walkers' loops below may ask of a source several times.
+  std::map<std::int64_t, bool> present;
+  const auto on_disk = [&](const Session& source) {
+    const auto known = present.find(source.id);
+    return known != present.end() ? known->second : present[source.id] = recording_present(source);
   };
+  const auto has_room = [&](const Session* source) { return taken[source->id] < request.max_viewers && on_disk(*source); };
   const auto first_of = [&](const std::string& walker) -> const Session* {
     for (const Session* source : sources) {
       if (source->uid == walker && has_room(source)) return source;
@@ -65,7 +69,7 @@ YokeChoice choose_yoke_source(const std::vector<Session>& sessions, const YokeRe
   for (const Session* watcher : watchers) {
     if (watcher->uid != request.watcher_uid || watcher->scenario != request.scenario) continue;
     const auto source = shown_by_id.find(watcher->yoked_to);
-    if (source != shown_by_id.end() && recording_present(*source->second)) {
+    if (source != shown_by_id.end() && on_disk(*source->second)) {
       choice.source = *source->second;
       return choice;
     }
